@@ -1,0 +1,98 @@
+"""Computed-torque tracking law (23) and the position-only allocation (25)-(26).
+
+The law computes a generalized force tau = [tau_x (N), tau_y (N), tau_phi (N m)]
+that would make the tracking error obey the linear equation (24). With one
+force of magnitude F and angle beta the body can realise (tau_x, tau_y) exactly
+but not tau_phi at the same time; (25)-(26) realise the position part and leave
+the rotation to itself.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.linalg import expm
+
+from .params import Body, Gains
+
+__all__ = ["computed_torque", "allocate", "wrap_angle", "error_dynamics_solution"]
+
+
+def wrap_angle(angle) -> np.ndarray:
+    """Wrap angles (rad) to the interval (-pi, pi]."""
+    angle = np.asarray(angle, dtype=float)
+    return np.pi - np.mod(np.pi - angle, 2 * np.pi)
+
+
+def computed_torque(body: Body, gains: Gains, ref, t, z, dz) -> np.ndarray:
+    """Computed-torque demand, eq. (23).
+
+    tau = M ddz_d + N(dz) + Kv (dz_d - dz) + Kp (z_d - z), with N(dz) = (c xdot, c ydot, c_phi phidot).
+    ``ref`` is a reference (:mod:`lib.trajectories`), ``t`` time(s) in s, ``z`` and
+    ``dz`` the actual configuration and its rate, shape (..., 3).
+    Returns tau = [tau_x (N), tau_y (N), tau_phi (N m)], shape (..., 3).
+    """
+    z = np.asarray(z, dtype=float)
+    dz = np.asarray(dz, dtype=float)
+    m = np.array([body.m, body.m, body.I])
+    return (m * ref.ddz(t) + body.drag * dz
+            + gains.kv * (ref.dz(t) - dz) + gains.kp * (ref.z(t) - z))
+
+
+def allocate(tau, phi, force_limit: float | None = None, angle_limit: float | None = None):
+    """Force magnitude and angle realising (tau_x, tau_y), eqs. (25)-(26).
+
+    F = sqrt(tau_x^2 + tau_y^2) (N) and beta = Arg(tau_x + i tau_y) - phi (rad),
+    wrapped to (-pi, pi]; tau_phi (``tau[..., 2]``, if present) is ignored.
+
+    Limits, applied when given:
+
+    * ``force_limit`` (N, > 0): F is capped, F <- min(F, force_limit), the
+      direction kept;
+    * ``angle_limit`` (rad, in (0, pi]): beta is clipped to
+      [-angle_limit, angle_limit]. A demanded direction behind the body
+      (|beta| > angle_limit) is replaced by the nearest admissible direction,
+      so beta jumps from +angle_limit to -angle_limit when the demand passes
+      straight behind the body.
+
+    When tau_x = tau_y = 0 no force is needed: F = 0 and beta = 0 by
+    definition (the direction of a zero force is immaterial).
+
+    Returns (F, beta) as arrays of the broadcast shape of tau[..., 0] and phi.
+    """
+    tau = np.asarray(tau, dtype=float)
+    if tau.ndim == 0 or tau.shape[-1] not in (2, 3):
+        raise ValueError(f"tau must have a last axis of length 2 or 3, got shape {tau.shape}")
+    tx, ty = tau[..., 0], tau[..., 1]
+    F = np.hypot(tx, ty)
+    beta = np.where(F > 0, wrap_angle(np.arctan2(ty, tx) - np.asarray(phi, dtype=float)), 0.0)
+    F = np.broadcast_to(F, beta.shape).copy()
+    if force_limit is not None:
+        _check_limit("force_limit", force_limit, upper=np.inf)
+        F = np.minimum(F, force_limit)
+    if angle_limit is not None:
+        _check_limit("angle_limit", angle_limit, upper=np.pi)
+        beta = np.clip(beta, -angle_limit, angle_limit)
+    return F, beta
+
+
+def _check_limit(name: str, value, upper: float) -> None:
+    if isinstance(value, bool) or not np.isscalar(value) or not np.isfinite(value) or not 0 < value <= upper:
+        raise ValueError(f"{name} must be a finite number in (0, {upper}], got {value!r}")
+
+
+def error_dynamics_solution(body: Body, gains: Gains, e0, de0, t) -> np.ndarray:
+    """Analytic solution e(t) of the error equation (24), M ë + Kv ė + Kp e = 0.
+
+    ``e0``, ``de0`` are the errors z_d - z and their rates at t = 0 (length 3);
+    ``t`` is an array of times (s). Returns e(t), shape t.shape + (3,). Each
+    axis is the free response of a linear oscillator, computed with the
+    matrix exponential of its companion matrix.
+    """
+    t = np.asarray(t, dtype=float)
+    m = np.array([body.m, body.m, body.I])
+    out = np.empty(t.shape + (3,))
+    for i in range(3):
+        A = np.array([[0.0, 1.0], [-gains.kp[i] / m[i], -gains.kv[i] / m[i]]])
+        Phi = expm(A * t.reshape(-1, 1, 1))
+        out[..., i] = (Phi @ np.array([e0[i], de0[i]]))[:, 0].reshape(t.shape)
+    return out

@@ -1,0 +1,103 @@
+"""Physical and feedback parameters (the paper's Table 1, printed as "Table 5").
+
+Both classes are frozen dataclasses validated on construction: a non-positive
+or non-finite value raises :class:`ValueError` naming the offending field.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields
+
+import numpy as np
+
+__all__ = ["Body", "Gains", "PAPER_Z0", "PAPER_DZ0"]
+
+#: Initial configuration of the paper's Table: x = 1 m, y = 0 m, phi = pi/2 rad.
+PAPER_Z0 = (1.0, 0.0, math.pi / 2)
+#: Initial velocities of the paper's Table: the body starts at rest.
+PAPER_DZ0 = (0.0, 0.0, 0.0)
+
+
+def _check_positive(owner: str, name: str, value) -> None:
+    arr = np.asarray(value, dtype=float)
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{owner}.{name} must be finite, got {value!r}")
+    if not np.all(arr > 0):
+        raise ValueError(f"{owner}.{name} must be positive, got {value!r}")
+
+
+@dataclass(frozen=True)
+class Body:
+    """The planar rigid body of eqs. (2)-(4), defaults from the paper's Table.
+
+    Attributes
+    ----------
+    m : mass (kg).
+    I : moment of inertia about the centre of mass C, I_C (kg m^2).
+    a : distance from C to the point where the force acts (m).
+    c : linear viscous drag coefficient (N s / m).
+    c_phi : rotational viscous drag coefficient (N m s).
+    """
+
+    m: float = 2.0
+    I: float = 0.1
+    a: float = 0.4
+    c: float = 0.6
+    c_phi: float = 0.1
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+                raise ValueError(f"Body.{f.name} must be a real number, got {value!r}")
+            _check_positive("Body", f.name, value)
+            object.__setattr__(self, f.name, float(value))
+
+    @property
+    def mass_matrix(self) -> np.ndarray:
+        """M of eq. (22): diag(m, m, I_C)."""
+        return np.diag([self.m, self.m, self.I])
+
+    @property
+    def drag(self) -> np.ndarray:
+        """Drag coefficients (c, c, c_phi), so that N(dz) = drag * dz in eq. (22)."""
+        return np.array([self.c, self.c, self.c_phi])
+
+
+def _as_gain(owner: str, name: str, value) -> np.ndarray:
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim == 0:
+        arr = np.full(3, float(arr))
+    if arr.shape != (3,):
+        raise ValueError(f"{owner}.{name} must be a scalar or have length 3 (x, y, phi), got shape {arr.shape}")
+    _check_positive(owner, name, arr)
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True)
+class Gains:
+    """Diagonal PD gains of the computed-torque law, eq. (23).
+
+    ``kp`` (N/m on x, y; N m/rad on phi) and ``kv`` (N s/m; N m s/rad) are
+    each a scalar (same gain on every axis) or a length-3 sequence for the
+    axes (x, y, phi). Defaults are the paper's Table: Kp = 5.2, Kv = sqrt(10.4).
+    The phi entries enter tau_phi only, which the position-only allocation
+    (25)-(26) ignores.
+    """
+
+    kp: float | tuple = 5.2
+    kv: float | tuple = field(default=math.sqrt(10.4))
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "kp", _as_gain("Gains", "kp", self.kp))
+        object.__setattr__(self, "kv", _as_gain("Gains", "kv", self.kv))
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Gains):
+            return NotImplemented
+        return bool(np.array_equal(self.kp, other.kp) and np.array_equal(self.kv, other.kv))
+
+    def __hash__(self) -> int:
+        return hash((tuple(self.kp), tuple(self.kv)))

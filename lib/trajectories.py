@@ -1,0 +1,159 @@
+"""Reference trajectories z_d(t) = [x_d (m), y_d (m), phi_d (rad)]: the circle
+(27) and the figure eight (28), with exact first and second derivatives.
+
+All methods take a scalar or an array of times t (s) and return an array of
+shape t.shape + (3,).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Reference", "Circle", "Eight", "circle", "eight", "make", "NAMES"]
+
+
+def _check_shape(R: float, theta: float) -> tuple[float, float]:
+    for name, v in (("R", R), ("theta", theta)):
+        if isinstance(v, bool) or not np.isscalar(v) or not np.isfinite(v):
+            raise ValueError(f"trajectory parameter {name} must be a finite real number, got {v!r}")
+    if R <= 0:
+        raise ValueError(f"trajectory radius R must be positive, got {R!r}")
+    if theta == 0:
+        raise ValueError("trajectory angular rate theta must be non-zero (theta = 0 is a standstill)")
+    return float(R), float(theta)
+
+
+class Reference:
+    """Interface of a reference: ``z(t)``, ``dz(t)``, ``ddz(t)`` and ``period`` (s)."""
+
+    period: float
+
+    def z(self, t) -> np.ndarray:  # pragma: no cover - interface
+        raise NotImplementedError
+
+    def dz(self, t) -> np.ndarray:  # pragma: no cover - interface
+        raise NotImplementedError
+
+    def ddz(self, t) -> np.ndarray:  # pragma: no cover - interface
+        raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class Circle(Reference):
+    """Circle of radius R (m) run at angular rate theta (rad/s), heading tangent, eq. (27).
+
+    z_d = [R cos(theta t), R sin(theta t), theta t + pi/2].
+    """
+
+    R: float = 2.0
+    theta: float = math.pi / 4
+
+    def __post_init__(self) -> None:
+        R, th = _check_shape(self.R, self.theta)
+        object.__setattr__(self, "R", R)
+        object.__setattr__(self, "theta", th)
+
+    @property
+    def period(self) -> float:
+        return 2 * math.pi / abs(self.theta)
+
+    def z(self, t) -> np.ndarray:
+        s = self.theta * np.asarray(t, dtype=float)
+        return np.stack([self.R * np.cos(s), self.R * np.sin(s), s + math.pi / 2], axis=-1)
+
+    def dz(self, t) -> np.ndarray:
+        s = self.theta * np.asarray(t, dtype=float)
+        R, th = self.R, self.theta
+        return np.stack([-R * th * np.sin(s), R * th * np.cos(s), np.full_like(s, th)], axis=-1)
+
+    def ddz(self, t) -> np.ndarray:
+        s = self.theta * np.asarray(t, dtype=float)
+        R, th = self.R, self.theta
+        return np.stack([-R * th**2 * np.cos(s), -R * th**2 * np.sin(s), np.zeros_like(s)], axis=-1)
+
+
+@dataclass(frozen=True)
+class Eight(Reference):
+    """Figure eight, eq. (28): x_d = R/2 sin(2 theta t), y_d = R sin(theta t).
+
+    The desired heading is the direction of the path's tangent. The paper
+    writes it as Arg(cos 2 theta t + i cos theta t), which jumps by 2 pi where
+    the tangent points backwards along x. Here it is the continuous branch
+
+        phi_d = pi + atan2(-cos(theta t), -cos(2 theta t)),
+
+    equal to the paper's Arg modulo 2 pi. It is continuous because
+    -(cos 2s + i cos s) never lies on the negative real axis (that would need
+    cos s = 0 and cos 2s > 0, but cos s = 0 gives cos 2s = -1). It is periodic
+    with the period of the path and oscillates about pi.
+    """
+
+    R: float = 2.0
+    theta: float = math.pi / 4
+
+    def __post_init__(self) -> None:
+        R, th = _check_shape(self.R, self.theta)
+        object.__setattr__(self, "R", R)
+        object.__setattr__(self, "theta", th)
+
+    @property
+    def period(self) -> float:
+        return 2 * math.pi / abs(self.theta)
+
+    def heading(self, t) -> np.ndarray:
+        """Continuous tangent angle phi_d(t) (rad)."""
+        s = self.theta * np.asarray(t, dtype=float)
+        sign = np.sign(self.theta)
+        # for theta < 0 the velocity reverses, the tangent turns by pi
+        base = np.pi + np.arctan2(-np.cos(s), -np.cos(2 * s))
+        return base if sign > 0 else base - np.pi
+
+    def z(self, t) -> np.ndarray:
+        s = self.theta * np.asarray(t, dtype=float)
+        return np.stack([0.5 * self.R * np.sin(2 * s), self.R * np.sin(s), self.heading(t)], axis=-1)
+
+    def dz(self, t) -> np.ndarray:
+        s = self.theta * np.asarray(t, dtype=float)
+        R, th = self.R, self.theta
+        num = 2 * np.cos(s) * np.sin(2 * s) - np.cos(2 * s) * np.sin(s)
+        den = np.cos(2 * s) ** 2 + np.cos(s) ** 2
+        return np.stack([R * th * np.cos(2 * s), R * th * np.cos(s), th * num / den], axis=-1)
+
+    def ddz(self, t) -> np.ndarray:
+        s = self.theta * np.asarray(t, dtype=float)
+        R, th = self.R, self.theta
+        num = 2 * np.cos(s) * np.sin(2 * s) - np.cos(2 * s) * np.sin(s)
+        den = np.cos(2 * s) ** 2 + np.cos(s) ** 2
+        dnum = 3 * np.cos(s) * np.cos(2 * s)
+        dden = -2 * np.sin(4 * s) - np.sin(2 * s)
+        return np.stack([
+            -2 * R * th**2 * np.sin(2 * s),
+            -R * th**2 * np.sin(s),
+            th**2 * (dnum * den - num * dden) / den**2,
+        ], axis=-1)
+
+
+def circle(R: float = 2.0, theta: float = math.pi / 4) -> Circle:
+    """The circle reference of eq. (27); defaults from the paper's Table."""
+    return Circle(R, theta)
+
+
+def eight(R: float = 2.0, theta: float = math.pi / 4) -> Eight:
+    """The figure-eight reference of eq. (28). The paper does not state R and
+    theta for its Fig. 3; the defaults reuse the circle's (see Chapter 3)."""
+    return Eight(R, theta)
+
+
+NAMES = {"circle": circle, "eight": eight}
+
+
+def make(name: str, R: float, theta: float) -> Reference:
+    """Build a reference by name (``"circle"`` or ``"eight"``)."""
+    try:
+        factory = NAMES[name]
+    except (KeyError, TypeError):
+        raise ValueError(f"unknown trajectory {name!r}; known: {sorted(NAMES)}") from None
+    return factory(R, theta)

@@ -1,0 +1,89 @@
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+from hypothesis.extra.numpy import arrays
+
+from lib import control, model, trajectories as T
+from lib.params import Body, Gains
+
+vec3 = arrays(float, 3, elements=st.floats(-50, 50, allow_nan=False))
+angle = st.floats(-10.0, 10.0)
+
+
+@given(tau=vec3, phi=angle)
+def test_allocate_reproduces_tau_x_and_tau_y_exactly_when_unlimited(tau, phi):
+    F, beta = control.allocate(tau, phi)
+    Q = model.generalized_force(F, beta, phi)
+    np.testing.assert_allclose(Q[:2], tau[:2], atol=1e-12 * (1 + np.abs(tau[:2]).max()))
+    assert F >= 0 and -np.pi < beta <= np.pi
+
+
+@given(tau=arrays(float, (20, 3), elements=st.floats(-50, 50)), phi=angle,
+       fmax=st.floats(0.1, 20.0), bmax=st.floats(0.05, np.pi))
+def test_allocate_limits_hold(tau, phi, fmax, bmax):
+    F, beta = control.allocate(tau, phi, force_limit=fmax, angle_limit=bmax)
+    assert np.all(F <= fmax) and np.all(np.abs(beta) <= bmax)
+    F0, beta0 = control.allocate(tau, phi)
+    # the force cap keeps the direction and the angle limit keeps admissible directions
+    np.testing.assert_allclose(F, np.minimum(F0, fmax))
+    inside = np.abs(beta0) <= bmax
+    np.testing.assert_allclose(beta[inside], beta0[inside])
+    np.testing.assert_allclose(np.abs(beta[~inside]), bmax)
+
+
+def test_allocate_angle_limit_jumps_sides_when_demand_passes_behind_the_body():
+    phi = 0.0
+    just_left = [np.cos(np.pi - 1e-3), np.sin(np.pi - 1e-3)]
+    just_right = [np.cos(np.pi + 1e-3), np.sin(np.pi + 1e-3)]
+    _, b1 = control.allocate(just_left, phi, angle_limit=1.0)
+    _, b2 = control.allocate(just_right, phi, angle_limit=1.0)
+    assert b1 == 1.0 and b2 == -1.0
+
+
+def test_allocate_zero_demand_is_zero_force_at_zero_angle():
+    F, beta = control.allocate(np.zeros((3, 3)), np.array([0.3, -2.0, 5.0]))
+    np.testing.assert_array_equal(F, 0.0)
+    np.testing.assert_array_equal(beta, 0.0)
+
+
+@pytest.mark.parametrize("kw,msg", [({"force_limit": 0.0}, "force_limit"), ({"force_limit": np.nan}, "force_limit"),
+                                    ({"angle_limit": 4.0}, "angle_limit"), ({"angle_limit": -0.1}, "angle_limit")])
+def test_allocate_rejects_bad_limits(kw, msg):
+    with pytest.raises(ValueError, match=msg):
+        control.allocate([1.0, 0.0, 0.0], 0.0, **kw)
+
+
+def test_allocate_rejects_wrong_shape():
+    with pytest.raises(ValueError, match="tau must have a last axis of length 2 or 3"):
+        control.allocate(np.zeros(4), 0.0)
+
+
+@given(st.floats(-100, 100))
+def test_wrap_angle_lands_in_half_open_interval(a):
+    w = control.wrap_angle(a)
+    assert -np.pi < w <= np.pi
+    assert np.isclose(np.cos(w), np.cos(a), atol=1e-9) and np.isclose(np.sin(w), np.sin(a), atol=1e-9)
+
+
+@pytest.mark.parametrize("ref", [T.circle(2.0, 0.8), T.eight(1.5, 0.6)])
+def test_computed_torque_on_the_reference_is_inverse_dynamics(ref):
+    """On the reference (e = 0), tau = M ddz_d + N(dz_d) (eq. 23), so an input realising
+    tau exactly on all three axes would reproduce ddz_d through (2)-(4)."""
+    body, gains = Body(), Gains()
+    t = np.linspace(0, 10, 50)
+    tau = control.computed_torque(body, gains, ref, t, ref.z(t), ref.dz(t))
+    ddz = (tau - body.drag * ref.dz(t)) / np.array([body.m, body.m, body.I])
+    np.testing.assert_allclose(ddz, ref.ddz(t), atol=1e-12)
+
+
+def test_error_dynamics_solution_solves_eq24():
+    body, gains = Body(), Gains(kp=[5.2, 3.0, 1.0], kv=[1.0, 2.0, 0.5])
+    t = np.linspace(0, 5, 2001)
+    e = control.error_dynamics_solution(body, gains, [1.0, -0.5, 0.2], [0.0, 1.5, -1.0], t)
+    h = t[1] - t[0]
+    de = np.gradient(e, h, axis=0, edge_order=2)
+    dde = np.gradient(de, h, axis=0, edge_order=2)
+    m = np.array([body.m, body.m, body.I])
+    resid = m * dde + gains.kv * de + gains.kp * e
+    assert np.abs(resid[5:-5]).max() < 1e-4
+    np.testing.assert_allclose(e[0], [1.0, -0.5, 0.2], atol=1e-14)

@@ -1,0 +1,80 @@
+import numpy as np
+import pytest
+
+from lib import control, trajectories as T
+from lib.params import Body, Gains
+from lib.simulate import SimulationError, simulate
+
+
+@pytest.mark.parametrize("ref", [T.circle(), T.eight()], ids=["circle", "eight"])
+def test_position_error_follows_eq24_analytically(ref):
+    body, gains = Body(), Gains()
+    res = simulate(body, gains, ref, 40.0)
+    e_exact = control.error_dynamics_solution(body, gains, res.error[0], res.derror[0], res.t)
+    assert np.abs(res.error[:, :2] - e_exact[:, :2]).max() < 1e-8
+    # and the analytic solution has decayed: (29)-(30)
+    assert np.abs(res.error[-1, :2]).max() < 1e-4
+
+
+def test_result_frame_has_one_row_per_sample():
+    res = simulate(Body(), Gains(), T.circle(), 2.0, t_eval=np.linspace(0, 2, 11))
+    df = res.to_frame()
+    assert len(df) == 11 and {"t_s", "x_m", "ex_m", "F_N", "beta_rad"} <= set(df.columns)
+    np.testing.assert_allclose(df["ex_m"], res.z_d[:, 0] - res.z[:, 0])
+    np.testing.assert_allclose(res.rotation_error(), -res.error[:, 2])
+
+
+def test_default_initial_state_is_the_papers_table():
+    res = simulate(Body(), Gains(), T.circle(), 1.0)
+    np.testing.assert_allclose(res.z[0], [1.0, 0.0, np.pi / 2])
+    np.testing.assert_allclose(res.dz[0], 0.0)
+
+
+def test_force_limit_is_respected_along_the_solution():
+    res = simulate(Body(), Gains(), T.eight(), 20.0, force_limit=4.0, rtol=1e-8, atol=1e-8)
+    assert res.F.max() <= 4.0 and np.isclose(res.F.max(), 4.0)
+
+
+class _Exploding:
+    period = 1.0
+
+    def z(self, t):
+        return np.zeros(np.shape(t) + (3,))
+
+    dz = z
+
+    def ddz(self, t):
+        return np.stack(np.broadcast_arrays(np.exp(np.asarray(t) * 50.0), 0.0 * np.asarray(t), 0.0 * np.asarray(t)), -1)
+
+
+def test_blow_up_raises_with_time_and_variable():
+    with pytest.raises(SimulationError, match=r"blew up at t = .* s: \|.*\| reached"):
+        simulate(Body(), Gains(), _Exploding(), 5.0)
+
+
+class _NaNRef(_Exploding):
+    def ddz(self, t):
+        return np.where(np.asarray(t)[..., None] > 0.5, np.nan, 0.0) * np.ones(3)
+
+
+def test_non_finite_solution_raises_naming_the_time():
+    with pytest.raises(SimulationError, match=r"non-finite at t = 0\.5"):
+        simulate(Body(), Gains(), _NaNRef(), 2.0)
+
+
+@pytest.mark.parametrize("kw,exc,msg", [
+    ({"t_end": 0.0}, ValueError, "t_end must be a positive"),
+    ({"t_end": np.nan}, ValueError, "t_end must be a positive"),
+    ({"z0": [1.0, 2.0]}, ValueError, r"z0 must have shape \(3,\)"),
+    ({"dz0": [0.0, np.nan, 0.0]}, ValueError, "dz0 must be finite"),
+    ({"force_limit": -1.0}, ValueError, "force_limit"),
+    ({"angle_limit": 7.0}, ValueError, "angle_limit"),
+    ({"t_eval": [0.0, 2.0]}, ValueError, "t_eval"),
+    ({"ref": "circle"}, TypeError, "ref must be a reference"),
+    ({"body": None}, TypeError, "body must be"),
+])
+def test_simulate_rejects_bad_input(kw, exc, msg):
+    args = dict(body=Body(), gains=Gains(), ref=T.circle(), t_end=1.0)
+    args.update(kw)
+    with pytest.raises(exc, match=msg):
+        simulate(**args)
