@@ -1,3 +1,5 @@
+import functools
+
 import numpy as np
 import pytest
 import sympy as sp
@@ -29,16 +31,23 @@ def test_body_frame_form_matches_configuration_form(body, q, F, beta):
     np.testing.assert_allclose(fd, rhs, rtol=1e-6, atol=1e-6)
 
 
+@functools.lru_cache(maxsize=1)
+def _symbolic_fields():
+    """The derived f, g1, g2 as numpy functions of (q, m, I, a, c, c_phi)."""
+    sm = symbolic.derive_body_frame()
+    p = sm.params
+    args = [list(sm.q), p["m"], p["I"], p["a"], p["c"], p["c_phi"]]
+    return tuple(sp.lambdify(args, field, "numpy") for field in (sm.f, sm.g1, sm.g2))
+
+
 @given(body=bodies, q=states)
 @settings(max_examples=100, deadline=None)
 def test_numeric_drift_equals_symbolic_derivation(body, q):
-    sm = symbolic.derive_body_frame()
-    p = sm.params
-    subs = {p["m"]: body.m, p["I"]: body.I, p["a"]: body.a, p["c"]: body.c, p["c_phi"]: body.c_phi}
-    fnum = sp.lambdify(list(sm.q), sm.f.subs(subs), "numpy")
-    np.testing.assert_allclose(np.ravel(fnum(*q)), model.f(body, q), rtol=1e-12, atol=1e-12)
-    np.testing.assert_allclose(np.array(sm.g1.subs(subs), float).ravel(), model.g1(body), rtol=1e-15)
-    np.testing.assert_allclose(np.array(sm.g2.subs(subs), float).ravel(), model.g2(body), rtol=1e-15)
+    f_sym, g1_sym, g2_sym = _symbolic_fields()
+    params = (body.m, body.I, body.a, body.c, body.c_phi)
+    np.testing.assert_allclose(np.ravel(f_sym(q, *params)), model.f(body, q), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(np.ravel(g1_sym(q, *params)).astype(float), model.g1(body), rtol=1e-15)
+    np.testing.assert_allclose(np.ravel(g2_sym(q, *params)).astype(float), model.g2(body), rtol=1e-15)
 
 
 def test_printed_drift_differs_only_in_the_v2_row_by_twice_v1_omega():
