@@ -14,7 +14,8 @@ from scipy.linalg import expm
 
 from .params import Body, Gains
 
-__all__ = ["computed_torque", "allocate", "wrap_angle", "error_dynamics_solution"]
+__all__ = ["computed_torque", "allocate", "allocate_least_squares", "input_matrix", "wrap_angle",
+           "error_dynamics_solution"]
 
 
 def wrap_angle(angle) -> np.ndarray:
@@ -66,6 +67,21 @@ def allocate(tau, phi, force_limit: float | None = None, angle_limit: float | No
     F = np.hypot(tx, ty)
     beta = np.where(F > 0, wrap_angle(np.arctan2(ty, tx) - np.asarray(phi, dtype=float)), 0.0)
     F = np.broadcast_to(F, beta.shape).copy()
+    return _limit(F, beta, force_limit, angle_limit)
+
+
+def input_matrix(phi, body: Body) -> np.ndarray:
+    """B(phi) with Q = B(phi) u, u = (u1, u2) = (F cos beta, F sin beta), eq. (22).
+
+    B = [[cos phi, -sin phi], [sin phi, cos phi], [0, a]]; shape phi.shape + (3, 2).
+    """
+    phi = np.asarray(phi, dtype=float)
+    c, s = np.cos(phi), np.sin(phi)
+    z, a = np.zeros_like(phi), np.full_like(phi, body.a)
+    return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1), np.stack([z, a], -1)], -2)
+
+
+def _limit(F, beta, force_limit, angle_limit):
     if force_limit is not None:
         _check_limit("force_limit", force_limit, upper=np.inf)
         F = np.minimum(F, force_limit)
@@ -73,6 +89,48 @@ def allocate(tau, phi, force_limit: float | None = None, angle_limit: float | No
         _check_limit("angle_limit", angle_limit, upper=np.pi)
         beta = np.clip(beta, -angle_limit, angle_limit)
     return F, beta
+
+
+def allocate_least_squares(tau, phi, body: Body, weights=(1.0, 1.0, 0.0),
+                           force_limit: float | None = None, angle_limit: float | None = None):
+    """Force and angle minimising the weighted residual of the whole demand (23).
+
+    Solves min_u sum_i w_i (tau_i - Q_i(u))^2 with Q = B(phi) u (see
+    :func:`input_matrix`), u = (F cos beta, F sin beta): the optimisation the
+    paper poses after eq. (24) and leaves unsolved. Q is linear in u, so this
+    is linear least squares with the closed form
+
+        u* = (W^(1/2) B)^+ W^(1/2) tau,
+
+    the minimum-norm solution when B^T W B is singular (e.g. w_x = w_y = 0).
+    For w_x = w_y = w it reduces to
+    u1 = cos(phi) tau_x + sin(phi) tau_y and
+    u2 = [w (-sin(phi) tau_x + cos(phi) tau_y) + a w_phi tau_phi] / (w + a^2 w_phi);
+    with w_phi = 0 it is exactly the position-only law (25)-(26).
+
+    ``weights`` = (w_x, w_y, w_phi) >= 0, not all zero (units: w_phi weighs a
+    torque residual in (N m)^2 against force residuals in N^2). Limits are then
+    applied as in :func:`allocate` (cap on F, clip of beta): a projection of the
+    unconstrained optimum, not the optimum under the limits.
+
+    Returns (F (N), beta (rad)), beta in (-pi, pi]; F = 0, beta = 0 when u* = 0.
+    """
+    tau = np.asarray(tau, dtype=float)
+    if tau.ndim == 0 or tau.shape[-1] != 3:
+        raise ValueError(f"tau must have a last axis of length 3 (tau_x, tau_y, tau_phi), got shape {tau.shape}")
+    w = np.asarray(weights, dtype=float)
+    if w.shape != (3,) or not np.all(np.isfinite(w)) or np.any(w < 0) or not np.any(w > 0):
+        raise ValueError(f"weights must be three finite non-negative numbers, not all zero, got {weights!r}")
+    if not isinstance(body, Body):
+        raise TypeError(f"body must be a lib.params.Body, got {type(body).__name__}")
+    sw = np.sqrt(w)
+    A = sw[:, None] * input_matrix(phi, body)                  # (..., 3, 2)
+    A = np.broadcast_to(A, np.broadcast_shapes(A.shape, tau.shape[:-1] + (3, 2)))
+    rhs = (sw * tau)[..., None]                                # (..., 3, 1)
+    u = (np.linalg.pinv(A) @ rhs)[..., 0]                      # (..., 2)
+    F = np.hypot(u[..., 0], u[..., 1])
+    beta = np.where(F > 0, np.arctan2(u[..., 1], u[..., 0]), 0.0)
+    return _limit(F, beta, force_limit, angle_limit)
 
 
 def _check_limit(name: str, value, upper: float) -> None:

@@ -1,0 +1,88 @@
+"""The least-squares allocation that solves the paper's open problem of Sec. 4."""
+
+import numpy as np
+import pytest
+import sympy as sp
+from hypothesis import given, settings, strategies as st
+from hypothesis.extra.numpy import arrays
+
+from lib import control, model
+from lib.params import Body
+
+vec3 = arrays(float, 3, elements=st.floats(-20, 20))
+weights = st.tuples(st.floats(0.0, 5.0), st.floats(0.0, 5.0), st.floats(0.0, 5.0)).filter(lambda w: max(w) > 0.01)
+
+
+def _cost(F, beta, tau, phi, body, w):
+    Q = model.generalized_force(F, beta, phi) * np.array([1.0, 1.0, body.a])
+    return np.sum(np.asarray(w) * (tau - Q) ** 2, axis=-1)
+
+
+@given(tau=vec3, phi=st.floats(-4, 4), w=weights)
+@settings(max_examples=60, deadline=None)
+def test_least_squares_cost_is_never_worse_than_a_dense_grid_search(tau, phi, w):
+    body = Body()
+    F, beta = control.allocate_least_squares(tau, phi, body, w)
+    best = _cost(F, beta, tau, phi, body, w)
+    Fmax = 2.0 * (np.abs(tau).max() / min(1.0, body.a) + 1.0)
+    Fg, bg = np.meshgrid(np.linspace(0.0, Fmax, 401), np.linspace(-np.pi, np.pi, 721))
+    grid = _cost(Fg, bg, tau, phi, body, w).min()
+    assert best <= grid + 1e-9 * (1 + grid)
+
+
+@given(tau=arrays(float, (8, 3), elements=st.floats(-20, 20)), phi=arrays(float, 8, elements=st.floats(-4, 4)),
+       wxy=st.floats(0.01, 10.0))
+def test_zero_phi_weight_is_the_papers_position_only_law(tau, phi, wxy):
+    F, beta = control.allocate_least_squares(tau, phi, Body(), (wxy, wxy, 0.0))
+    F0, beta0 = control.allocate(tau, phi)
+    np.testing.assert_allclose(F, F0, atol=1e-9)
+    # compare directions only where a force is demanded
+    on = F0 > 1e-9
+    np.testing.assert_allclose(np.cos(beta[on] - beta0[on]), 1.0, atol=1e-9)
+
+
+def test_closed_form_for_equal_position_weights_matches_sympy_normal_equations():
+    phi, a, w, wp = sp.symbols("varphi a w w_phi", positive=True)
+    tx, ty, tp = sp.symbols("tau_x tau_y tau_phi", real=True)
+    B = sp.Matrix([[sp.cos(phi), -sp.sin(phi)], [sp.sin(phi), sp.cos(phi)], [0, a]])
+    W = sp.diag(w, w, wp)
+    u = sp.simplify((B.T * W * B).inv() * B.T * W * sp.Matrix([tx, ty, tp]))
+    expected_u2 = (w * (-sp.sin(phi) * tx + sp.cos(phi) * ty) + a * wp * tp) / (w + a**2 * wp)
+    assert sp.simplify(u[0] - (sp.cos(phi) * tx + sp.sin(phi) * ty)) == 0
+    assert sp.simplify(u[1] - expected_u2) == 0
+    # and the numeric implementation agrees with the symbolic formula
+    body, vals = Body(), {phi: 0.7, a: 0.4, w: 1.3, wp: 2.1, tx: 1.0, ty: -2.0, tp: 0.5}
+    F, beta = control.allocate_least_squares([1.0, -2.0, 0.5], 0.7, body, (1.3, 1.3, 2.1))
+    np.testing.assert_allclose([F * np.cos(beta), F * np.sin(beta)], [float(u[0].subs(vals)), float(u[1].subs(vals))],
+                               rtol=1e-12)
+
+
+@given(tau=arrays(float, (10, 3), elements=st.floats(-20, 20)), phi=st.floats(-4, 4),
+       fmax=st.floats(0.1, 10.0), bmax=st.floats(0.05, np.pi))
+def test_least_squares_limits_hold(tau, phi, fmax, bmax):
+    F, beta = control.allocate_least_squares(tau, phi, Body(), (1.0, 1.0, 3.0), force_limit=fmax, angle_limit=bmax)
+    assert np.all(F <= fmax) and np.all(np.abs(beta) <= bmax)
+
+
+def test_pure_torque_weight_realises_tau_phi_exactly():
+    body = Body()
+    F, beta = control.allocate_least_squares([3.0, -1.0, 0.2], 0.3, body, (0.0, 0.0, 1.0))
+    np.testing.assert_allclose(F * np.sin(beta) * body.a, 0.2, rtol=1e-12)
+    # minimum-norm solution: no useless longitudinal force
+    np.testing.assert_allclose(F * np.cos(beta), 0.0, atol=1e-12)
+
+
+@pytest.mark.parametrize("kw,exc,msg", [
+    ({"weights": (0.0, 0.0, 0.0)}, ValueError, "not all zero"),
+    ({"weights": (1.0, -1.0, 0.0)}, ValueError, "non-negative"),
+    ({"weights": (1.0, 1.0)}, ValueError, "weights"),
+    ({"weights": (1.0, np.nan, 1.0)}, ValueError, "finite"),
+    ({"tau": [1.0, 2.0]}, ValueError, "tau must have a last axis of length 3"),
+    ({"body": "body"}, TypeError, "body must be"),
+    ({"force_limit": 0.0}, ValueError, "force_limit"),
+])
+def test_least_squares_rejects_bad_input(kw, exc, msg):
+    args = dict(tau=[1.0, 2.0, 3.0], phi=0.0, body=Body())
+    args.update(kw)
+    with pytest.raises(exc, match=msg):
+        control.allocate_least_squares(**args)
