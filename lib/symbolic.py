@@ -8,12 +8,19 @@ the two can be compared row by row.
 
 from __future__ import annotations
 
+from collections import Counter
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import Union
 
 import sympy as sp
 
-__all__ = ["SymbolicModel", "derive_body_frame", "printed_drift", "parameter_symbols"]
+__all__ = [
+    "SymbolicModel", "derive_body_frame", "printed_drift", "parameter_symbols",
+    "Bracket", "lie_bracket", "evaluate_bracket", "bracket_latex", "bracket_degree",
+    "accessibility_matrix", "model_fields", "printed_brackets", "compare_printed_brackets",
+]
 
 
 def parameter_symbols() -> dict[str, sp.Symbol]:
@@ -126,6 +133,163 @@ def printed_drift(model: SymbolicModel | None = None) -> sp.Matrix:
     ])
 
 
+# ---------------------------------------------------------------- Lie brackets (Sec. 3)
+
+Bracket = Union[str, tuple]
+"""A bracket expression: a field name (``"f"``, ``"g1"``) or a pair ``(X, Y)``
+standing for [X, Y]; e.g. ``("g1", ("f", "g2"))`` is [g1, [f, g2]]."""
+
+
+def _column(v, name: str) -> sp.Matrix:
+    if not isinstance(v, sp.MatrixBase):
+        raise TypeError(f"{name} must be a sympy column Matrix, got {type(v).__name__}")
+    if v.shape[1] != 1:
+        raise ValueError(f"{name} must be a column vector (n x 1), got shape {v.shape}")
+    return sp.Matrix(v)
+
+
+def _coordinates(q) -> list[sp.Symbol]:
+    if isinstance(q, sp.MatrixBase):
+        coords = list(q)
+    elif isinstance(q, Sequence) and not isinstance(q, str):
+        coords = list(q)
+    else:
+        raise TypeError(f"q must be a sympy Matrix or a sequence of sympy Symbols, got {type(q).__name__}")
+    if not coords:
+        raise ValueError("q is empty: a vector field needs at least one coordinate")
+    bad = [c for c in coords if not isinstance(c, sp.Symbol)]
+    if bad:
+        raise TypeError(f"q must contain sympy Symbols only, got {bad[0]!r} ({type(bad[0]).__name__})")
+    if len(set(coords)) != len(coords):
+        raise ValueError(f"q has repeated coordinates: {coords}")
+    return coords
+
+
+def _tidy(expr: sp.Expr) -> sp.Expr:
+    """Cheap canonical form: expand, then put over a common denominator.
+
+    Enough to expose zeros in this model, whose fields are linear in
+    (cos phi, sin phi); trigonometric identities are left to the caller.
+    """
+    return sp.expand(sp.cancel(sp.expand(expr)))
+
+
+def lie_bracket(f: sp.MatrixBase, g: sp.MatrixBase, q) -> sp.Matrix:
+    """Lie (Jacobi) bracket of eq. (16): [f, g] = (dg/dq) f - (df/dq) g.
+
+    ``f`` and ``g`` are n x 1 sympy matrices, ``q`` the n coordinates (sympy
+    Symbols). Works for any pair of vector fields, not only this model. Each
+    entry is expanded and put over a common denominator.
+
+    Raises TypeError for non-sympy input (e.g. numpy arrays, or expressions
+    in place of coordinate symbols) and ValueError when the dimensions of f,
+    g and q disagree.
+    """
+    f = _column(f, "f")
+    g = _column(g, "g")
+    coords = _coordinates(q)
+    if not (f.shape[0] == g.shape[0] == len(coords)):
+        raise ValueError(f"dimension mismatch: f has {f.shape[0]} rows, g has {g.shape[0]}, "
+                         f"q has {len(coords)} coordinates")
+    return (g.jacobian(coords) * f - f.jacobian(coords) * g).applyfunc(_tidy)
+
+
+def _check_bracket(expr: Bracket) -> None:
+    if isinstance(expr, str):
+        return
+    if not (isinstance(expr, tuple) and len(expr) == 2):
+        raise TypeError(f"a bracket is a field name or a pair (X, Y), got {expr!r}")
+    _check_bracket(expr[0])
+    _check_bracket(expr[1])
+
+
+def evaluate_bracket(expr: Bracket, fields: Mapping[str, sp.MatrixBase], q,
+                     cache: dict | None = None) -> sp.Matrix:
+    """The vector field of a bracket expression, built with :func:`lie_bracket`.
+
+    ``fields`` maps names to sympy columns (e.g. :func:`model_fields`);
+    ``cache`` (a dict) may be shared between calls to reuse inner brackets.
+    """
+    _check_bracket(expr)
+    cache = {} if cache is None else cache
+    if expr in cache:
+        return cache[expr]
+    if isinstance(expr, str):
+        if expr not in fields:
+            raise KeyError(f"unknown field {expr!r}; known: {sorted(fields)}")
+        out = _column(fields[expr], expr)
+    else:
+        out = lie_bracket(evaluate_bracket(expr[0], fields, q, cache),
+                          evaluate_bracket(expr[1], fields, q, cache), q)
+    cache[expr] = out
+    return out
+
+
+def bracket_latex(expr: Bracket) -> str:
+    """LaTeX of a bracket expression: ``("g1", ("f", "g2"))`` -> ``[g_1, [f, g_2]]``."""
+    _check_bracket(expr)
+    if isinstance(expr, str):
+        name = expr.rstrip("0123456789")
+        idx = expr[len(name):]
+        return f"{name}_{{{idx}}}" if idx else name
+    return f"[{bracket_latex(expr[0])}, {bracket_latex(expr[1])}]"
+
+
+def bracket_degree(expr: Bracket) -> Counter:
+    """How many times each field enters the bracket (Sussmann's degrees delta^i)."""
+    _check_bracket(expr)
+    if isinstance(expr, str):
+        return Counter({expr: 1})
+    return bracket_degree(expr[0]) + bracket_degree(expr[1])
+
+
+def accessibility_matrix(fields: Mapping[str, sp.MatrixBase], brackets: Sequence[Bracket], q,
+                         cache: dict | None = None) -> sp.Matrix:
+    """The matrix of eq. (18): the listed brackets side by side, C = [B_1 | B_2 | ...].
+
+    Its rank at a state is the dimension of the span of those brackets there;
+    rank n everywhere proves the Lie algebra rank condition (Definition 4).
+    """
+    if len(brackets) == 0:
+        raise ValueError("brackets is empty")
+    cache = {} if cache is None else cache
+    return sp.Matrix.hstack(*(evaluate_bracket(b, fields, q, cache) for b in brackets))
+
+
+def _symbols_only():
+    """State and parameter symbols of :func:`derive_body_frame` without deriving
+    (sympy symbols are equal when name and assumptions are)."""
+    from types import SimpleNamespace
+
+    q = sp.Matrix(sp.symbols("x y varphi v_1 v_2 omega", real=True))
+    return SimpleNamespace(q=q, params=parameter_symbols())
+
+
+def model_fields(model: SymbolicModel | None = None, *, printed: bool = False) -> dict[str, sp.Matrix]:
+    """``{"f": f, "g1": g1, "g2": g2}`` of eqs. (6), (9), (10); ``printed=True``
+    uses the drift as printed in (6) instead of the derived one."""
+    model = model or derive_body_frame()
+    f = printed_drift(model) if printed else model.f
+    return {"f": f, "g1": model.g1, "g2": model.g2}
+
+
+def printed_brackets(model: SymbolicModel | None = None) -> dict[Bracket, sp.Matrix]:
+    """The three brackets exactly as printed under eq. (21) of the paper.
+
+    (The fifth entry of [f, g2] is printed with ``I`` for ``I_C``.)
+    """
+    model = model or _symbols_only()
+    _, _, PHI, V1, V2, W = model.q
+    m, I, a, c, c_phi = (model.params[k] for k in ("m", "I", "a", "c", "c_phi"))
+    cos, sin = sp.cos(PHI), sp.sin(PHI)
+    return {
+        ("f", "g1"): sp.Matrix([-cos / m, sin / m, 0, -c / m**2, -W / m, 0]),
+        ("f", "g2"): sp.Matrix([sin / m, -cos / m, -a / I, -V2 * a / I - W / m,
+                                c / m**2 - V1 * a / I, a * c_phi / I**2]),
+        ("g1", ("f", "g2")): sp.Matrix([0, 0, 0, 0, -a / (m * I), 0]),
+    }
+
+
 # ---------------------------------------------------------------- errata (Sec. 2)
 
 def _check_drift_row() -> "Verdict":
@@ -144,6 +308,186 @@ def _check_drift_row() -> "Verdict":
     )
 
 
+# ---------------------------------------------------------------- errata (Sec. 3)
+
+def _slug(expr: Bracket) -> str:
+    if isinstance(expr, str):
+        return expr
+    return f"{_slug(expr[0])}-{_slug(expr[1])}"
+
+
+def compare_printed_brackets(model: SymbolicModel | None = None) -> list[dict]:
+    """Entry-by-entry comparison of the brackets printed under eq. (21).
+
+    For every entry: the printed value, the value from the derived drift, the
+    value from the printed drift (6), and a verdict: ``"correct"``,
+    ``"drift typo"`` (wrong, but exactly what the printed drift gives) or
+    ``"independent"`` (wrong even with the printed drift). ``"opposite sign
+    convention"`` flags entries equal to the bracket [g, f] of the printed drift.
+    """
+    model = model or derive_body_frame()
+    true_fields, printed_fields = model_fields(model), model_fields(model, printed=True)
+    out = []
+    for expr, printed in printed_brackets(model).items():
+        true = evaluate_bracket(expr, true_fields, model.q)
+        from_printed = evaluate_bracket(expr, printed_fields, model.q)
+        for i in range(printed.shape[0]):
+            ok = sp.simplify(printed[i] - true[i]) == 0
+            typo = sp.simplify(printed[i] - from_printed[i]) == 0
+            opposite = sp.simplify(printed[i] + from_printed[i]) == 0 and printed[i] != 0
+            out.append(dict(
+                bracket=expr, row=i + 1, key=f"eq21-{_slug(expr)}-row{i + 1}",
+                printed=printed[i], derived=true[i], printed_drift=from_printed[i],
+                verdict="correct" if ok else ("drift typo" if typo else "independent"),
+                opposite_convention=bool(opposite and not ok),
+            ))
+    return out
+
+
+def _entry_check(expr: Bracket, row: int, corrected) -> Callable[[], "Verdict"]:
+    def check():
+        from .errata import Verdict
+
+        model = derive_body_frame()
+        rec = next(r for r in compare_printed_brackets(model) if r["bracket"] == expr and r["row"] == row)
+        fixed = corrected(model)
+        why = {"drift typo": "follows from the sign typo of (6): the printed drift gives exactly the printed entry",
+               "independent": f"independent of (6): the printed drift gives {sp.sstr(rec['printed_drift'])}",
+               "correct": "entry is correct"}[rec["verdict"]]
+        if rec["opposite_convention"]:
+            why += " (the sign of the opposite convention [g, f])"
+        return Verdict(
+            printed_holds=rec["verdict"] == "correct",
+            corrected_holds=sp.simplify(fixed - rec["derived"]) == 0,
+            detail=f"derived {sp.sstr(rec['derived'])}; {why}",
+        )
+    return check
+
+
+def _check_count() -> "Verdict":
+    from .controllability import free_lie_rank, paper_bracket_count, right_nested, witt_dimension
+    from .errata import Verdict
+
+    cases = [(w, r) for w in (1, 2) for r in (1, 2, 3)]
+    names = lambda w: ["f"] + [f"g{i + 1}" for i in range(w)]  # noqa: E731
+    indep = {(w, r): free_lie_rank(names(w), r) for w, r in cases}
+    wrong = [(w, r, paper_bracket_count(w, r), indep[w, r]) for w, r in cases
+             if paper_bracket_count(w, r) != indep[w, r]]
+    exprs_ok = all(len(right_nested(names(w), r)) == paper_bracket_count(w, r) for w, r in cases)
+    witt_ok = all(indep[w, r] == witt_dimension(w + 1, r + 1) for w, r in cases)
+    return Verdict(
+        printed_holds=not wrong,
+        corrected_holds=exprs_ok and witt_ok,
+        detail="(w, r, printed, independent): " + ", ".join(map(str, wrong)),
+    )
+
+
+def _counterexample():
+    """The textbook system x1' = u, x2' = x1^2: accessible at 0, not STLC."""
+    x1, x2 = sp.symbols("x_1 x_2", real=True)
+    return [x1, x2], {"f": sp.Matrix([0, x1**2]), "g": sp.Matrix([1, 0])}
+
+
+def _check_theorem6() -> "Verdict":
+    from .controllability import rest_report, sussmann_check
+    from .errata import Verdict
+
+    q, fields = _counterexample()
+    at0 = {q[0]: 0, q[1]: 0}
+    C = accessibility_matrix(fields, ["g", ("f", "g"), ("g", ("f", "g"))], q).subs(at0)
+    accessible = C.rank() == 2
+    # x2' = x1^2 + 0*u >= 0 for every state and input: x2 never decreases, so
+    # (0, -eps) is never reached and 0 is not interior to the reachable set
+    rate = fields["f"][1] + fields["g"][1] * sp.Symbol("u", real=True)
+    monotone = bool(rate.is_nonnegative)
+    counter = sussmann_check(fields, q, at0, drift="f", max_order=2)
+    return Verdict(
+        printed_holds=not (accessible and monotone),
+        corrected_holds=(not counter.all_bad_neutralised) and rest_report().complete,
+        detail=f"x1'=u, x2'=x1^2: rank {C.rank()} at 0, x2' >= 0 always; "
+               f"bad [g,[f,g]] neutralised: {counter.all_bad_neutralised}; "
+               f"this body at rest: Sussmann condition proven {rest_report().complete}",
+    )
+
+
+def _check_conclusion() -> "Verdict":
+    from .controllability import rest_report, strong_accessibility_det
+    from .errata import Verdict
+
+    model = derive_body_frame()
+    _, _, _, V1, V2, W = model.q
+    p = model.params
+    # configuration rates (rows 1-3) are free of the inputs and vanish only at rest
+    inputs_free = all(e == 0 for e in list(model.g1[:3]) + list(model.g2[:3]))
+    rest = sp.solve(list(model.f[:3]), [V1, V2, W], dict=True)
+    only_rest = rest == [{V1: 0, V2: 0, W: 0}]
+    rest_in_set = sp.simplify(W - p["a"] * p["m"] / p["I"] * V2).subs({V1: 0, V2: 0, W: 0}) == 0
+    det = strong_accessibility_det()
+    everywhere = det.free_symbols <= set(p.values()) and det != 0
+    return Verdict(
+        printed_holds=not (inputs_free and only_rest and rest_in_set),
+        corrected_holds=bool(everywhere) and rest_report().complete,
+        detail=f"off the printed set the configuration always moves (rest only at {rest}); "
+               f"det of strong-accessibility brackets = {sp.sstr(det)}; "
+               f"Sussmann at rest proven: {rest_report().complete}",
+    )
+
+
+def _check_f1_name() -> "Verdict":
+    from .errata import Verdict
+
+    model = derive_body_frame()
+    p = model.params
+    xd, yd, pd = sp.symbols("xdot ydot varphidot", real=True)
+    f1 = sp.Matrix([-p["c"] / p["m"] * xd, -p["c"] / p["m"] * yd, -p["c_phi"] / p["I"] * pd])  # eq. (1)
+    fields = model_fields(model)
+    g1g2 = evaluate_bracket(("g1", "g2"), fields, model.q)
+    try:
+        lie_bracket(f1, g1g2, model.q)
+        printed = True
+    except ValueError:
+        printed = False
+    corrected = evaluate_bracket(("f", ("g1", "g2")), fields, model.q)
+    return Verdict(
+        printed_holds=printed,
+        corrected_holds=all(e == 0 for e in corrected),
+        detail="f_1 of eq. (1) is a 3-vector (accelerations): [f_1, .] on the 6-dim state is undefined; "
+               "[f, [g1, g2]] = 0",
+    )
+
+
+#: wrong entries of the brackets printed under (21), with the corrected value (typed here,
+#: checked against the derivation)
+_ENTRY_ROWS = [
+    (("f", "g1"), 2, lambda M: -sp.sin(M.q[2]) / M.params["m"]),
+    (("f", "g1"), 4, lambda M: M.params["c"] / M.params["m"] ** 2),
+    (("f", "g1"), 5, lambda M: M.q[5] / M.params["m"]),
+    (("f", "g2"), 5, lambda M: M.params["c"] / M.params["m"] ** 2 + M.q[3] * M.params["a"] / M.params["I"]),
+    (("g1", ("f", "g2")), 5, lambda M: M.params["a"] / (M.params["m"] * M.params["I"])),
+]
+
+
+def _entry_rows():
+    from .errata import Erratum
+
+    model = _symbols_only()  # the LaTeX of the rows needs symbols only, not the derivation
+    printed = printed_brackets(model)
+    out = []
+    for expr, row, corrected in _ENTRY_ROWS:
+        out.append(Erratum(
+            key=f"eq21-{_slug(expr)}-row{row}",
+            where=f"Eq. (21), ${bracket_latex(expr)}$, row {row}",
+            printed=f"${sp.latex(printed[expr][row - 1])}$",
+            corrected=f"${sp.latex(corrected(model))}$",
+            verified_by="sympy bracket (16) of the derived fields, recomputed with the printed drift "
+                        "to classify (`lib.symbolic.compare_printed_brackets`); finite-difference "
+                        "brackets (`tests/test_symbolic.py::test_symbolic_brackets_match_finite_differences`)",
+            section="chapters/02_controllability",
+            check=_entry_check(expr, row, corrected),
+        ))
+    return out
+
+
 def _errata():
     from .errata import Erratum
 
@@ -158,6 +502,51 @@ def _errata():
                         "(`tests/test_model.py::test_printed_drift_diverges_from_configuration_form`)",
             section="chapters/01_model",
             check=_check_drift_row,
+        ),
+        *_entry_rows(),
+        Erratum(
+            key="sec3-also-f1",
+            where="Sec. 3, line after (21) (\"Also: ...\")",
+            printed=r"$[f_1, [g_1, g_2]] = 0$",
+            corrected=r"$[f, [g_1, g_2]] = 0$ ($f_1$ is the drift of the second-order form (1))",
+            verified_by="`lie_bracket` refuses the 3-dimensional $f_1$ on the 6-dimensional state; "
+                        "$[f,[g_1,g_2]]$ computed",
+            section="chapters/02_controllability",
+            check=_check_f1_name,
+        ),
+        Erratum(
+            key="sec3-bracket-count",
+            where="Sec. 3, after (20): number of $r$-th order brackets",
+            printed=r"$w(w+1)^r/2$",
+            corrected=r"$w(w+1)^r/2$ bracket expressions $[X_{a_1},[\dots,[X_i,X_j]]]$, $i<j$; "
+                      r"at most $\frac{1}{r+1}\sum_{d\mid r+1}\mu(d)(w+1)^{(r+1)/d}$ independent (Witt)",
+            verified_by="rank of the brackets expanded in the free associative algebra "
+                        "(`lib.controllability.free_lie_rank`) against Witt's formula, $w\\le 2$, $r\\le 3$",
+            section="chapters/02_controllability",
+            check=_check_count,
+        ),
+        Erratum(
+            key="thm6-accessibility-stlc",
+            where="Theorem 6 (attributed to Sussmann 1987)",
+            printed="a locally accessible system with drift is small-time locally controllable",
+            corrected="false in general ($\\dot x_1 = u$, $\\dot x_2 = x_1^2$ is accessible at 0, not STLC); "
+                      "sufficient at an equilibrium: accessibility and every bad bracket neutralised "
+                      "by good brackets of lower degree (Sussmann 1987, Thm. 7.3)",
+            verified_by="counterexample computed with `lie_bracket`; `lib.controllability.sussmann_check`",
+            section="chapters/02_controllability",
+            check=_check_theorem6,
+        ),
+        Erratum(
+            key="sec3-stlc-conclusion",
+            where="Sec. 3, last sentence (conclusion from Def. 4 and \"theory 7\")",
+            printed=r"accessible and STLC for $q_0$ with $\omega \ne \frac{am}{I_C}v_2$",
+            corrected=r"strongly accessible at every state; STLC at every rest state "
+                      r"($v_1=v_2=\omega=0$, inside the excluded set); with bounded inputs not STLC "
+                      r"at any state where the body moves, which includes every state the claim names",
+            verified_by="constant determinant of six brackets without $f$; Sussmann's condition at rest "
+                        "(`lib.controllability.rest_report`); configuration rates free of inputs",
+            section="chapters/02_controllability",
+            check=_check_conclusion,
         ),
     ]
 
