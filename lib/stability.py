@@ -200,3 +200,311 @@ def circle_rotation_rhs(body: Body, R, theta, p, v_p) -> np.ndarray:
     p, v_p = np.asarray(p, dtype=float), np.asarray(v_p, dtype=float)
     return (-body.c_phi / body.I * v_p - body.a * body.c * theta * R / body.I * np.sin(p)
             + body.a * body.m * theta**2 * R / body.I * np.cos(p) - body.c_phi * theta / body.I)
+
+
+# ---------------------------------------------------------------- the reduced rotation ODE
+
+_C = None
+
+
+def _tableau():
+    """Butcher tableau of the 8th-order Dormand-Prince method (scipy's ``DOP853``),
+    used here with a fixed step so that every grid point lands on the same phases."""
+    global _C
+    if _C is None:
+        from scipy.integrate import DOP853
+        n = DOP853.n_stages
+        _C = (np.array(DOP853.A[:n, :n]), np.array(DOP853.B), np.array(DOP853.C[:n]))
+    return _C
+
+
+def _shape(kind: str):
+    """Unit reference (R = 1 m, theta = 1 rad/s) of ``kind``: with s = Theta t,
+    x_d = R X(s), y_d = R Y(s), phi_d = H(s). Returns a function of s giving
+    (X', Y', X'', Y'', H, H') and the winding of H per period (turns)."""
+    from .trajectories import make
+
+    ref = make(kind, 1.0, 1.0)
+
+    def at(s):
+        s = np.asarray(s, dtype=float)
+        dz, ddz, z = ref.dz(s), ref.ddz(s), ref.z(s)
+        return dz[..., 0], dz[..., 1], ddz[..., 0], ddz[..., 1], z[..., 2], dz[..., 2]
+
+    winding = int(round((ref.z(2 * np.pi)[2] - ref.z(0.0)[2]) / (2 * np.pi)))
+    return at, winding
+
+
+def _check_grid(R, Theta):
+    R = np.atleast_1d(np.asarray(R, dtype=float))
+    Theta = np.atleast_1d(np.asarray(Theta, dtype=float))
+    if R.ndim != 1 or Theta.ndim != 1:
+        raise ValueError(f"R and Theta must be 1-D arrays (one grid point per pair), got shapes {R.shape}, {Theta.shape}")
+    if R.size == 0:
+        raise ValueError("R and Theta must not be empty")
+    if R.shape != Theta.shape:
+        raise ValueError(f"R and Theta must have equal length, got {R.size} and {Theta.size}")
+    if not (np.all(np.isfinite(R)) and np.all(np.isfinite(Theta))):
+        raise ValueError("R and Theta must be finite")
+    if np.any(R <= 0):
+        raise ValueError(f"R must be positive (m), got min {R.min()!r}")
+    if np.any(Theta <= 0):
+        raise ValueError(f"Theta must be positive (rad/s), got min {Theta.min()!r}")
+    return R, Theta
+
+
+def _coefficients(body: Body, R, Theta):
+    """Coefficients of the rotation equation in the phase s = Theta t, w = dphi/ds:
+
+        w' = -A w + B (Y' cos phi - X' sin phi) + C (Y'' cos phi - X'' sin phi),
+
+    A = c_phi / (I Theta), B = a R c / (I Theta), C = a R m / I  (eq. (32) divided by I Theta^2)."""
+    A = body.c_phi / (body.I * Theta)
+    B = body.a * R * body.c / (body.I * Theta)
+    C = body.a * R * body.m / body.I
+    return A, B, C
+
+
+def steps_per_period(body: Body, kind: str, R, Theta, h_lambda: float = 0.25) -> np.ndarray:
+    """Fixed steps per reference period for each point: a power of two (>= 64)
+    such that h Lambda <= ``h_lambda``, where Lambda = A + sqrt(B v_max + C a_max)
+    bounds the moduli of the eigenvalues of the linearised equation (in s)."""
+    at, _ = _shape(kind)
+    s = np.linspace(0, 2 * np.pi, 721)
+    X1, Y1, X2, Y2, _, _ = at(s)
+    vmax, amax = np.hypot(X1, Y1).max(), np.hypot(X2, Y2).max()
+    A, B, C = _coefficients(body, np.asarray(R, float), np.asarray(Theta, float))
+    lam = A + np.sqrt(B * vmax + C * amax)
+    need = 2 * np.pi * lam / h_lambda
+    return np.maximum(64, 2 ** np.ceil(np.log2(need))).astype(int)
+
+
+def reduced_rotation(body: Body, kind: str, R: float, Theta: float, periods: int, *, steps: int | None = None,
+                     p0: float = 0.0, v0: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Integrate the reduced rotation equation (32) on the reference ``kind`` from
+    p(0) = ``p0`` (rad), dp/dt(0) = ``v0`` (rad/s), p = phi - phi_d, for ``periods``
+    reference periods. Returns (t (s), p (rad), dp/dt (rad/s)) at every step.
+
+    This is the exact closed loop (23), (25)-(26) when the position starts on the
+    reference (the position errors then stay zero)."""
+    R_, Th_ = _check_grid(R, Theta)
+    n = int(steps or steps_per_period(body, kind, R_, Th_)[0])
+    at, winding = _shape(kind)
+    phi, w = _run(body, kind, R_, Th_, n, periods, np.array([p0]), np.array([v0]), record=True)
+    s = np.arange(phi.shape[0]) * 2 * np.pi / n
+    _, _, _, _, H, H1 = at(s)
+    return s / Theta, phi[:, 0] - H, (w[:, 0] - H1) * Theta
+
+
+def _forcing(kind: str, n: int):
+    """Stage phases of one period and the unit reference there, for n steps per period."""
+    Aa, Bb, Cc = _tableau()
+    at, winding = _shape(kind)
+    h = 2 * np.pi / n
+    X1, Y1, X2, Y2, _, _ = at((np.arange(n)[:, None] + Cc[None, :]) * h)
+    _, _, _, _, H, _ = at(np.arange(1, n + 1) * h)
+    return h, X1, Y1, X2, Y2, H, winding
+
+
+def _period(phi, w, A, B, C, h, X1, Y1, X2, Y2):
+    """One reference period of fixed DOP853 steps for all points; returns (phi at
+    every step end, shape (n, N), final phi, final w)."""
+    Aa, Bb, Cc = _tableau()
+    n, stages = X1.shape
+    hA = Aa * h
+    hB = Bb * h
+    KP = np.empty((stages,) + phi.shape)
+    KW = np.empty_like(KP)
+    out = np.empty((n,) + phi.shape)
+    for j in range(n):
+        for i in range(stages):
+            if i == 0:
+                ps, ws = phi, w
+            else:
+                ps = phi + hA[i, :i] @ KP[:i]
+                ws = w + hA[i, :i] @ KW[:i]
+            KP[i] = ws
+            KW[i] = (B * Y1[j, i] + C * Y2[j, i]) * np.cos(ps) - (B * X1[j, i] + C * X2[j, i]) * np.sin(ps) - A * ws
+        phi = phi + hB @ KP
+        w = w + hB @ KW
+        out[j] = phi
+    return out, phi, w
+
+
+def _period_compiled_impl(phi, w, A, B, C, h, X1, Y1, X2, Y2, hA, hB, out):
+    """Same scheme as :func:`_period`, one point at a time in compiled loops."""
+    n, stages = X1.shape
+    kp = np.empty(stages)
+    kw = np.empty(stages)
+    for q in range(phi.size):
+        f, v, a_, b_, c_ = phi[q], w[q], A[q], B[q], C[q]
+        for j in range(n):
+            for i in range(stages):
+                ps, ws = f, v
+                for l in range(i):
+                    ps += hA[i, l] * kp[l]
+                    ws += hA[i, l] * kw[l]
+                kp[i] = ws
+                kw[i] = ((b_ * Y1[j, i] + c_ * Y2[j, i]) * math.cos(ps)
+                         - (b_ * X1[j, i] + c_ * X2[j, i]) * math.sin(ps) - a_ * ws)
+            for i in range(stages):
+                f += hB[i] * kp[i]
+                v += hB[i] * kw[i]
+            out[j, q] = f
+        phi[q], w[q] = f, v
+
+
+_COMPILED = None
+
+
+def _period_compiled(phi, w, A, B, C, h, X1, Y1, X2, Y2):
+    """:func:`_period` compiled with numba (the default engine; see the benchmark)."""
+    global _COMPILED
+    if _COMPILED is None:
+        import numba
+
+        _COMPILED = numba.njit(cache=True, fastmath=False)(_period_compiled_impl)
+    Aa, Bb, _ = _tableau()
+    phi, w = np.array(phi, dtype=float), np.array(w, dtype=float)
+    out = np.empty((X1.shape[0], phi.size))
+    _COMPILED(phi, w, np.ascontiguousarray(A, float), np.ascontiguousarray(B, float),
+              np.ascontiguousarray(C, float), h, X1, Y1, X2, Y2, Aa * h, Bb * h, out)
+    return out, phi, w
+
+
+ENGINES = {"numba": _period_compiled, "numpy": _period}
+
+
+def _initial(kind, Theta, p0, v0):
+    at, _ = _shape(kind)
+    _, _, _, _, H0, H10 = at(0.0)
+    return H0 + p0, H10 + v0 / Theta
+
+
+def _run(body, kind, R, Theta, n, periods, p0, v0, record=False):
+    """Fixed-step DOP853 in s for all points at once; with ``record`` the states at every step."""
+    h, X1, Y1, X2, Y2, H, winding = _forcing(kind, n)
+    A, B, C = _coefficients(body, R, Theta)
+    phi, w = _initial(kind, Theta, p0, v0)
+    outs = [phi[None].copy()]
+    for _ in range(periods):
+        out, phi, w = _period(phi, w, A, B, C, h, X1, Y1, X2, Y2)
+        outs.append(out)
+    return np.concatenate(outs), w
+
+
+def classify_samples(P: np.ndarray, tol: float = 1e-9) -> dict:
+    """Classify the steady state from the rotation error sampled over the last periods.
+
+    ``P`` has shape (L_max + 1, N, n): for N points, the last L_max + 1 reference
+    periods of p (rad) at n equally spaced phases each (oldest first). For each lag
+    L = 1..L_max the defect is d_L = max_j |p_j - p_{j-L periods} - 2 pi k_L|, with
+    k_L the whole number of turns slipped in L periods. The smallest L with
+    d_L <= ``tol`` is the period (in reference periods); k_L = 0 makes the point
+    ``periodic``, k_L != 0 ``slipping``; if no lag qualifies it is ``irregular``
+    (the smallest defect is reported). Returns arrays: regime, period, slip
+    (turns per reference period), defect, range (max - min of p over the last
+    ``period`` periods).
+    """
+    P = np.asarray(P, dtype=float)
+    if P.ndim != 3 or P.shape[0] < 2 or P.shape[2] < 1:
+        raise ValueError(f"P must have shape (L_max + 1 >= 2, N, n >= 1), got {P.shape}")
+    Lmax, N = P.shape[0] - 1, P.shape[1]
+    last = P[-1]
+    defects = np.empty((Lmax, N))
+    turns = np.empty((Lmax, N))
+    for L in range(1, Lmax + 1):
+        d = last - P[-1 - L]
+        k = np.round(d[:, -1] / (2 * np.pi))
+        turns[L - 1] = k
+        defects[L - 1] = np.abs(d - 2 * np.pi * k[:, None]).max(axis=1)
+    ok = defects <= tol
+    any_ok = ok.any(axis=0)
+    Lidx = np.where(any_ok, ok.argmax(axis=0), defects.argmin(axis=0))
+    cols = np.arange(N)
+    k = turns[Lidx, cols]
+    period = Lidx + 1
+    regime = np.where(~any_ok, "irregular", np.where(k == 0, "periodic", "slipping"))
+    rng = np.empty(N)
+    for L in np.unique(period):
+        sel = period == L
+        window = P[-L:, sel, :].transpose(1, 0, 2).reshape(sel.sum(), -1)
+        rng[sel] = window.max(axis=1) - window.min(axis=1)
+    return dict(regime=regime, period=period, slip=k / period, defect=defects[Lidx, cols], range=rng)
+
+
+def rotation_sweep(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, tol: float = 1e-9,
+                   min_periods: int = 4, max_periods: int = 200, max_lag: int = 4,
+                   h_lambda: float = 0.25, steps: int | None = None, engine: str = "numba") -> pd.DataFrame:
+    """Steady state of the rotation error p = phi - phi_d on the reference ``kind``
+    (``"eight"`` or ``"circle"``) for every grid point (R_i, Theta_i), started on the
+    reference with p(0) = ``p0`` (rad) and dp/dt(0) = ``v0`` (rad/s) (scalars or arrays).
+
+    All points are integrated together (numpy-vectorised over points), by a fixed-step
+    8th-order Dormand-Prince scheme in the phase s = Theta t, so every point covers
+    the same number of reference periods, with a power-of-two number of steps per
+    period (:func:`steps_per_period`, or ``steps``). ``engine`` is ``"numba"``
+    (compiled loops, the default) or ``"numpy"`` (vectorised over points; same
+    scheme, same results to rounding, slower: see ``benchmarks/bench_eight_sweep.py``). After each period from
+    ``min_periods`` on, :func:`classify_samples` is applied to the last ``max_lag + 1``
+    periods; a point whose defect is <= ``tol`` (rad) is finished, the others go on
+    to at most ``max_periods``.
+
+    Returns a DataFrame, one row per point, in order: R (m), Theta (rad/s), range
+    (rad), regime, period (reference periods), slip (turns per period), defect
+    (rad, the convergence measure), periods (integrated), steps (per period).
+    """
+    if kind not in ("eight", "circle"):
+        raise ValueError(f"kind must be 'eight' or 'circle', got {kind!r}")
+    if not isinstance(body, Body):
+        raise TypeError(f"body must be a lib.params.Body, got {type(body).__name__}")
+    R, Theta = _check_grid(R, Theta)
+    N = R.size
+    p0 = np.broadcast_to(np.asarray(p0, dtype=float), (N,)).copy()
+    v0 = np.broadcast_to(np.asarray(v0, dtype=float), (N,)).copy()
+    if not (np.all(np.isfinite(p0)) and np.all(np.isfinite(v0))):
+        raise ValueError("initial p0 and v0 must be finite")
+    for name, v, lo in (("min_periods", min_periods, 1), ("max_lag", max_lag, 1)):
+        if not isinstance(v, (int, np.integer)) or v < lo:
+            raise ValueError(f"{name} must be an integer >= {lo}, got {v!r}")
+    if not isinstance(max_periods, (int, np.integer)) or max_periods < max(min_periods, max_lag + 1):
+        raise ValueError(f"max_periods must be an integer >= min_periods and > max_lag, got {max_periods!r}")
+    if engine not in ENGINES:
+        raise ValueError(f"engine must be one of {sorted(ENGINES)}, got {engine!r}")
+    step_period = ENGINES[engine]
+    if not (np.isfinite(tol) and tol > 0):
+        raise ValueError(f"tol must be positive, got {tol!r}")
+    n_pts = (np.full(N, int(steps)) if steps is not None
+             else steps_per_period(body, kind, R, Theta, h_lambda))
+    cols = {k: np.empty(N, dtype=object if k == "regime" else float)
+            for k in ("range", "regime", "period", "slip", "defect", "periods")}
+    for n in np.unique(n_pts):
+        idx = np.flatnonzero(n_pts == n)
+        h, X1, Y1, X2, Y2, H, winding = _forcing(kind, int(n))
+        A, B, C = _coefficients(body, R[idx], Theta[idx])
+        phi, w = _initial(kind, Theta[idx], p0[idx], v0[idx])
+        P = np.zeros((max_lag + 1, idx.size, int(n)))
+        for k in range(1, max_periods + 1):
+            out, phi, w = step_period(phi, w, A, B, C, h, X1, Y1, X2, Y2)
+            P = np.roll(P, -1, axis=0)
+            P[-1] = (out - H[:, None] - 2 * np.pi * winding * (k - 1)).T
+            if k < max(min_periods, max_lag + 1) and k < max_periods:
+                continue
+            c = classify_samples(P[-(min(k, max_lag) + 1):], tol)
+            done = (c["defect"] <= tol) | (k == max_periods)
+            for key in ("range", "regime", "period", "slip", "defect"):
+                cols[key][idx[done]] = c[key][done]
+            cols["periods"][idx[done]] = k
+            keep = ~done
+            if not keep.any():
+                break
+            idx, phi, w, A, B, C, P = idx[keep], phi[keep], w[keep], A[keep], B[keep], C[keep], P[:, keep]
+    frame = pd.DataFrame({"R": R, "Theta": Theta, **cols, "steps": n_pts})
+    return frame.astype({"period": int, "periods": int, "range": float, "slip": float, "defect": float})
+
+
+def eight_rotation_sweep(body: Body, R, Theta, **options) -> pd.DataFrame:
+    """Fig. 5: steady-state range of the rotation error on the eight (28), started on
+    the reference, for each pair (R_i (m), Theta_i (rad/s)). See :func:`rotation_sweep`
+    for the options and the columns."""
+    return rotation_sweep(body, "eight", R, Theta, **options)
