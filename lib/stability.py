@@ -34,7 +34,10 @@ from .symbolic import parameter_symbols
 __all__ = [
     "RotationEquation", "derive_rotation_equation", "printed_eq33", "derive_eight_equation",
     "printed_eq37", "circle_equilibria", "circle_critical_radius", "circle_eigenvalues",
-    "circle_jacobian", "circle_rotation_rhs",
+    "circle_jacobian", "circle_rotation_rhs", "circle_final_state", "circle_slipping_coexists",
+    "steps_per_period", "reduced_rotation", "classify_samples", "rotation_sweep", "eight_rotation_sweep",
+    "eight_heading_fourier", "heading_series", "PAPER_HEADING_SERIES", "ENGINES", "corrected_p0",
+    "printed_p0", "ERRATA",
 ]
 
 
@@ -508,3 +511,217 @@ def eight_rotation_sweep(body: Body, R, Theta, **options) -> pd.DataFrame:
     the reference, for each pair (R_i (m), Theta_i (rad/s)). See :func:`rotation_sweep`
     for the options and the columns."""
     return rotation_sweep(body, "eight", R, Theta, **options)
+
+
+# ---------------------------------------------------------------- the circle: global behaviour
+
+def _circle_arrays(body, R, theta, *arrays):
+    if not isinstance(body, Body):
+        raise TypeError(f"body must be a lib.params.Body, got {type(body).__name__}")
+    out = np.broadcast_arrays(*(np.atleast_1d(np.asarray(a, dtype=float)) for a in (R, theta) + arrays))
+    out = [np.ravel(a).copy() for a in out]
+    if out[0].size == 0:
+        raise ValueError("empty input arrays")
+    if not all(np.all(np.isfinite(a)) for a in out):
+        raise ValueError("inputs must be finite")
+    if np.any(out[0] <= 0) or np.any(out[1] <= 0):
+        raise ValueError("R (m) and theta (rad/s) must be positive")
+    return out
+
+
+def circle_final_state(body: Body, R, theta, p0=0.0, v0=0.0, t_end: float = 300.0,
+                       rtol: float = 1e-9, atol: float = 1e-9) -> pd.DataFrame:
+    """Integrate the corrected (33) from p(0) = ``p0`` (rad), p'(0) = ``v0`` (rad/s)
+    for ``t_end`` s, for all broadcast (R, theta, p0, v0) together (one stacked
+    ``solve_ivp``). Returns a DataFrame with R, theta, p0, v0, p_end, v_end and
+    ``regime``: ``settled`` if the end state is within 1e-4 of the stable
+    equilibrium (mod 2 pi) and at rest, else ``slipping`` (no equilibrium, or the
+    motion still turns)."""
+    from scipy.integrate import solve_ivp
+
+    R, theta, p0, v0 = _circle_arrays(body, R, theta, p0, v0)
+    N = R.size
+
+    def rhs(t, y):
+        p, v = y[:N], y[N:]
+        return np.concatenate([v, circle_rotation_rhs(body, R, theta, p, v)])
+
+    sol = solve_ivp(rhs, (0.0, t_end), np.concatenate([p0, v0]), method="DOP853", rtol=rtol, atol=atol,
+                    t_eval=[t_end])
+    p_end, v_end = sol.y[:N, -1], sol.y[N:, -1]
+    gap = np.full(N, np.inf)
+    for i in range(N):
+        try:
+            ps, _ = circle_equilibria(body, float(R[i]), float(theta[i]))
+        except ValueError:
+            continue
+        gap[i] = abs(math.remainder(p_end[i] - ps, 2 * math.pi))
+    settled = (gap < 1e-4) & (np.abs(v_end) < 1e-4)
+    return pd.DataFrame({"R": R, "theta": theta, "p0": p0, "v0": v0, "p_end": p_end, "v_end": v_end,
+                         "regime": np.where(settled, "settled", "slipping")})
+
+
+def circle_slipping_coexists(body: Body, R, theta, t_end: float = 1000.0) -> np.ndarray:
+    """Whether a slipping (running) motion of the corrected (33) coexists with the
+    stable equilibrium, for each broadcast (R (m), theta (rad/s)) with R > R_crit.
+
+    Test: follow the branch of the saddle's unstable manifold that leaves towards
+    decreasing p (the direction of the constant drag torque -c_phi theta). If it
+    passes the next saddle, p_saddle - 2 pi, the motion runs on for ever and a
+    running periodic orbit exists; if it falls into the stable equilibrium, every
+    motion not on the saddle's stable manifold settles. (This is the homoclinic
+    bifurcation of the damped driven pendulum, Strogatz 2015, Sec. 8.5.)
+    """
+    from scipy.integrate import solve_ivp
+
+    R, theta = _circle_arrays(body, R, theta)
+    N = R.size
+    ps = np.empty(N)
+    y0 = np.empty(2 * N)
+    for i in range(N):
+        _, sad = circle_equilibria(body, float(R[i]), float(theta[i]))
+        J = circle_jacobian(body, float(R[i]), float(theta[i]), sad)
+        lam, vec = np.linalg.eig(J)
+        u = np.real(vec[:, np.argmax(lam.real)])
+        u = -u if u[0] > 0 else u
+        ps[i] = sad
+        y0[i], y0[N + i] = sad + 1e-6 * u[0] / np.hypot(*u), 1e-6 * u[1] / np.hypot(*u)
+
+    def rhs(t, y):
+        p, v = y[:N], y[N:]
+        return np.concatenate([v, circle_rotation_rhs(body, R, theta, p, v)])
+
+    sol = solve_ivp(rhs, (0.0, t_end), y0, method="DOP853", rtol=1e-10, atol=1e-12, dense_output=True)
+    pmin = np.full(N, np.inf)
+    for chunk in np.array_split(np.linspace(0, t_end, 100001), 50):
+        pmin = np.minimum(pmin, sol.sol(chunk)[:N].min(axis=1))
+    return pmin < ps - 2 * np.pi
+
+
+# ---------------------------------------------------------------- the eight's tangent angle
+
+#: The paper's 3-term approximation of the eight's tangent angle (Sec. 6):
+#: phi_d ~ pi - 2.26 cos s - 0.24 cos 3s + 0.16 cos 5s, s = Theta t.
+PAPER_HEADING_SERIES = {0: math.pi, 1: -2.26, 3: -0.24, 5: 0.16}
+
+
+def eight_heading_fourier(n_harmonics: int = 9, n_samples: int = 4096) -> np.ndarray:
+    """Cosine Fourier coefficients a_0..a_{n_harmonics} of the eight's continuous
+    tangent angle phi_d(s) = pi + atan2(-cos s, -cos 2s) (rad), s = Theta t, by FFT.
+
+    phi_d is even in s, so phi_d = a_0 + sum_k a_k cos(k s); the half-period
+    symmetry phi_d(s + pi) - pi = -(phi_d(s) - pi) leaves only odd k."""
+    if not isinstance(n_harmonics, (int, np.integer)) or n_harmonics < 0:
+        raise ValueError(f"n_harmonics must be a non-negative integer, got {n_harmonics!r}")
+    at, _ = _shape("eight")
+    s = 2 * np.pi * np.arange(n_samples) / n_samples
+    H = at(s)[4]
+    c = np.fft.rfft(H) / n_samples
+    a = 2 * c.real
+    a[0] = c[0].real
+    return a[: n_harmonics + 1]
+
+
+def heading_series(coefficients: dict, s) -> np.ndarray:
+    """Evaluate a cosine series {k: a_k} at phases s (rad)."""
+    s = np.asarray(s, dtype=float)
+    return sum(a * np.cos(k * s) for k, a in coefficients.items())
+
+
+# ---------------------------------------------------------------- errata (Sec. 6)
+
+def corrected_p0(k: int):
+    """Corrected closed form of the equilibria of (33), symbolic:
+    p0^(k) = k pi + arctan(m Theta / c) - arcsin((-1)^k c_phi / (a R sqrt(m^2 Theta^2 + c^2)))."""
+    s = derive_rotation_equation().params
+    m, a, c, cphi, R, Th = (s[n] for n in ("m", "a", "c", "c_phi", "R", "Theta"))
+    return k * sp.pi + sp.atan(m * Th / c) - sp.asin((-1) ** k * cphi / (a * R * sp.sqrt(m**2 * Th**2 + c**2)))
+
+
+def printed_p0(k: int, garbled: bool = True):
+    """The printed p0^(k) = k pi - arctan(m Theta/c) - arcsin(c_phi / (a c R cos(k pi) sqrt(m^2 Theta^2/(c+1)))).
+    With ``garbled=False`` the square root reads sqrt(m^2 Theta^2 / c^2 + 1), presumably what was meant."""
+    s = derive_rotation_equation().params
+    m, a, c, cphi, R, Th = (s[n] for n in ("m", "a", "c", "c_phi", "R", "Theta"))
+    root = sp.sqrt(m**2 * Th**2 / (c + 1)) if garbled else sp.sqrt(m**2 * Th**2 / c**2 + 1)
+    return k * sp.pi - sp.atan(m * Th / c) - sp.asin(cphi / (a * c * R * sp.cos(k * sp.pi) * root))
+
+
+def _table_values():
+    s = derive_rotation_equation().params
+    b = Body()
+    return {s["m"]: b.m, s["I"]: b.I, s["a"]: b.a, s["c"]: b.c, s["c_phi"]: b.c_phi, s["R"]: 2.0,
+            s["Theta"]: sp.pi / 4}
+
+
+def _check_eq33():
+    from .errata import Verdict
+
+    eq = derive_rotation_equation()
+    diff = sp.simplify(printed_eq33() - eq.rhs)
+    s = eq.params
+    corrected = printed_eq33() + 2 * s["a"] * s["m"] * s["Theta"] ** 2 * s["R"] / s["I"] * sp.cos(eq.p)
+    return Verdict(printed_holds=diff == 0, corrected_holds=sp.simplify(corrected - eq.rhs) == 0,
+                   detail=f"printed minus derived v_p' = {sp.sstr(diff)}")
+
+
+def _check_p0():
+    from .errata import Verdict
+
+    eq = derive_rotation_equation()
+    at_rest = eq.rhs.subs(eq.v_p, 0)
+    corrected_ok = all(sp.simplify(sp.expand_trig(at_rest.subs(eq.p, corrected_p0(k)))) == 0 for k in (0, 1))
+    vals = _table_values()
+    res_printed = [float(sp.N(at_rest.subs(eq.p, printed_p0(k)).subs(vals))) for k in (0, 1)]
+    res_corr = [float(sp.N(at_rest.subs(eq.p, corrected_p0(k)).subs(vals))) for k in (0, 1)]
+    return Verdict(printed_holds=max(abs(r) for r in res_printed) < 1e-9,
+                   corrected_holds=corrected_ok and max(abs(r) for r in res_corr) < 1e-12,
+                   detail=(f"residual of the derived (33) at rest, Table values, k = 0, 1: printed p0 "
+                           f"{res_printed[0]:.3g}, {res_printed[1]:.3g} rad/s^2; corrected p0 zero symbolically"))
+
+
+def _check_eq37():
+    from .errata import Verdict
+
+    _, torque, _ = derive_eight_equation()
+    diff = sp.simplify(sp.expand(printed_eq37(True) - torque))
+    return Verdict(printed_holds=diff == 0,
+                   corrected_holds=sp.simplify(sp.expand(printed_eq37(False) - torque)) == 0,
+                   detail=f"printed minus derived right side is nonzero: {sp.sstr(sp.factor(diff))}")
+
+
+def _errata():
+    from .errata import Erratum
+
+    sec = "chapters/05_stability"
+    return [
+        Erratum(
+            key="eq33-cos-sign",
+            where="Eq. (33), the $\\cos p$ term of $\\dot v_p$",
+            printed=r"$-\frac{am\Theta^2R}{I}\cos p$",
+            corrected=r"$+\frac{am\Theta^2R}{I}\cos p$",
+            verified_by="sympy derivation of (33) from (4), (25)-(26), (27) "
+                        "(`lib.stability.derive_rotation_equation`); simulation converges to the "
+                        "corrected p0 (`tests/test_stability.py::test_simulated_circle_converges_to_stable_equilibrium`)",
+            section=sec, check=_check_eq33),
+        Erratum(
+            key="eq33-p0",
+            where="Sec. 6, the equilibria $p_0^{(k)}$ of (33)",
+            printed=r"$k\pi - \arctan\frac{m\Theta}{c} - \arcsin\left(c_\varphi / acR\cos k\pi\sqrt{\frac{m^2\Theta^2}{c+1}}\right)$",
+            corrected=r"$k\pi + \arctan\frac{m\Theta}{c} - \arcsin\frac{(-1)^k c_\varphi}{aR\sqrt{m^2\Theta^2+c^2}}$",
+            verified_by="sympy substitution into the derived (33) (`lib.stability.corrected_p0`); "
+                        "`tests/test_stability.py::test_equilibria_solve_derived_equation`",
+            section=sec, check=_check_p0),
+        Erratum(
+            key="eq37-bracket",
+            where="Eq. (37), right side",
+            printed=r"$a\Theta R((c\cos\Theta t - m\Theta\sin\Theta t)\cos\varphi - (c\cos 2\Theta t - 2m\Theta\sin 2\Theta t))\sin\varphi$",
+            corrected=r"$a\Theta R((c\cos\Theta t - m\Theta\sin\Theta t)\cos\varphi - (c\cos 2\Theta t - 2m\Theta\sin 2\Theta t)\sin\varphi)$",
+            verified_by="sympy derivation of (37) from (32) and (28) (`lib.stability.derive_eight_equation`); "
+                        "the reduced equation against the full closed loop "
+                        "(`tests/test_stability.py::test_reduced_rotation_matches_full_closed_loop`)",
+            section=sec, check=_check_eq37),
+    ]
+
+
+ERRATA = _errata()
