@@ -283,10 +283,10 @@ def steps_per_period(body: Body, kind: str, R, Theta, h_lambda: float = 0.25) ->
 
 
 def reduced_rotation(body: Body, kind: str, R: float, Theta: float, periods: int, *, steps: int | None = None,
-                     p0: float = 0.0, v0: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                     p0: float = 0.0, v0: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """Integrate the reduced rotation equation (32) on the reference ``kind`` from
     p(0) = ``p0`` (rad), dp/dt(0) = ``v0`` (rad/s), p = phi - phi_d, for ``periods``
-    reference periods. Returns (t (s), p (rad), dp/dt (rad/s)) at every step.
+    reference periods. Returns (t (s), p (rad)) at every step (and t = 0).
 
     This is the exact closed loop (23), (25)-(26) when the position starts on the
     reference (the position errors then stay zero)."""
@@ -295,8 +295,8 @@ def reduced_rotation(body: Body, kind: str, R: float, Theta: float, periods: int
     at, winding = _shape(kind)
     phi, w = _run(body, kind, R_, Th_, n, periods, np.array([p0]), np.array([v0]), record=True)
     s = np.arange(phi.shape[0]) * 2 * np.pi / n
-    _, _, _, _, H, H1 = at(s)
-    return s / Theta, phi[:, 0] - H, (w[:, 0] - H1) * Theta
+    H = at(s)[4]
+    return s / Theta, phi[:, 0] - H
 
 
 def _forcing(kind: str, n: int):

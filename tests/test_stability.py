@@ -1,0 +1,149 @@
+"""Stability of the uncontrolled rotation (lib.stability, paper Sec. 6)."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st_
+
+from lib import simulate, stability, trajectories
+from lib.params import Body, Gains
+
+BODY = Body()
+
+
+def test_simulated_circle_converges_to_stable_equilibrium():
+    ref = trajectories.circle(2.0, math.pi / 4)
+    res = simulate.simulate(BODY, Gains(), ref, 60.0)
+    p_stable, _ = stability.circle_equilibria(BODY, 2.0, math.pi / 4)
+    assert res.rotation_error()[-1] == pytest.approx(p_stable, abs=1e-6)
+
+
+@settings(max_examples=60, deadline=None)
+@given(theta=st_.floats(0.05, 3.0), ratio=st_.floats(1.0001, 50.0))
+def test_equilibria_solve_derived_equation(theta, ratio):
+    R = ratio * stability.circle_critical_radius(BODY, theta)
+    for p0 in stability.circle_equilibria(BODY, R, theta):
+        assert -math.pi < p0 <= math.pi
+        assert stability.circle_rotation_rhs(BODY, R, theta, p0, 0.0) == pytest.approx(0.0, abs=1e-9)
+
+
+@settings(max_examples=40, deadline=None)
+@given(theta=st_.floats(0.05, 3.0), ratio=st_.floats(1.01, 50.0))
+def test_eigenvalues_match_finite_difference_jacobian(theta, ratio):
+    R = ratio * stability.circle_critical_radius(BODY, theta)
+    p_s, p_u = stability.circle_equilibria(BODY, R, theta)
+    h = 1e-6
+    for p0, stable in ((p_s, True), (p_u, False)):
+        d_p = (stability.circle_rotation_rhs(BODY, R, theta, p0 + h, 0) -
+               stability.circle_rotation_rhs(BODY, R, theta, p0 - h, 0)) / (2 * h)
+        d_v = (stability.circle_rotation_rhs(BODY, R, theta, p0, h) -
+               stability.circle_rotation_rhs(BODY, R, theta, p0, -h)) / (2 * h)
+        lam = np.sort_complex(np.linalg.eigvals(np.array([[0, 1], [d_p, d_v]])))
+        if stable:
+            assert np.all(lam.real < 0)
+            np.testing.assert_allclose(lam, np.sort_complex(stability.circle_eigenvalues(BODY, R, theta)),
+                                       atol=1e-5 * (1 + abs(lam).max()))
+        else:  # the saddle: one positive and one negative real eigenvalue
+            assert lam.real.min() < 0 < lam.real.max() and np.all(abs(lam.imag) < 1e-9)
+
+
+def test_critical_radius_is_eq36_and_bounds_existence():
+    theta = 0.9
+    r_crit = stability.circle_critical_radius(BODY, theta)
+    assert r_crit == pytest.approx(BODY.c_phi / (BODY.a * math.sqrt(BODY.m**2 * theta**2 + BODY.c**2)))
+    stability.circle_equilibria(BODY, r_crit * (1 + 1e-9), theta)
+    with pytest.raises(ValueError, match="critical radius"):
+        stability.circle_equilibria(BODY, r_crit * 0.999, theta)
+    with pytest.raises(ValueError, match="critical radius"):
+        stability.circle_eigenvalues(BODY, r_crit * 0.5, theta)
+
+
+@pytest.mark.parametrize("R, theta", [(-1.0, 0.5), (1.0, 0.0), (float("nan"), 0.5), (1.0, -0.2)])
+def test_circle_functions_reject_bad_input(R, theta):
+    with pytest.raises(ValueError):
+        stability.circle_equilibria(BODY, R, theta)
+
+
+def test_below_critical_radius_the_rotation_slips():
+    theta = 1.0
+    r_crit = stability.circle_critical_radius(BODY, theta)
+    df = stability.circle_final_state(BODY, [0.8 * r_crit, 2.0 * r_crit], theta, 0.0, 0.0, t_end=200.0)
+    assert list(df.regime) == ["slipping", "settled"]
+
+
+@pytest.mark.parametrize("kind, R, theta, dp0, dv0", [("eight", 2.0, math.pi / 4, 0.7, -0.3),
+                                                       ("eight", 0.5, 1.3, -2.0, 1.0),
+                                                       ("circle", 1.0, 1.2, 2.5, 0.4)])
+def test_reduced_rotation_matches_full_closed_loop(kind, R, theta, dp0, dv0):
+    ref = trajectories.make(kind, R, theta)
+    t, p = stability.reduced_rotation(BODY, kind, R, theta, 3, steps=1024, p0=dp0, v0=dv0)
+    z0 = ref.z(0.0) + np.array([0.0, 0.0, dp0])
+    dz0 = ref.dz(0.0) + np.array([0.0, 0.0, dv0])
+    res = simulate.simulate(BODY, Gains(), ref, float(t[-1]), z0=z0, dz0=dz0, t_eval=t)
+    assert np.abs(res.error[:, :2]).max() < 1e-8          # the position stays on the reference
+    np.testing.assert_allclose(res.rotation_error(), p, atol=1e-7)
+
+
+def test_sweep_matches_per_point_solve_ivp_on_full_closed_loop():
+    R, Th = np.array([1.0, 3.0]), np.array([0.8, 0.3])
+    df = stability.eight_rotation_sweep(BODY, R, Th)
+    assert list(df.regime) == ["periodic", "periodic"]
+    for row in df.itertuples():
+        ref = trajectories.eight(row.R, row.Theta)
+        T = 2 * math.pi / row.Theta
+        t_last = T * (row.periods - 1) + T * np.arange(1, row.steps + 1) / row.steps
+        res = simulate.simulate(BODY, Gains(), ref, float(t_last[-1]), z0=ref.z(0.0), dz0=ref.dz(0.0),
+                                t_eval=t_last)
+        p = res.rotation_error()
+        assert row.range == pytest.approx(p.max() - p.min(), abs=1e-6)
+
+
+def test_sweep_engines_agree_and_rows_keep_order():
+    R, Th = np.array([3.0, 1.0, 2.0]), np.array([0.2, 0.8, 0.6])    # periodic points (chaos would
+    a = stability.eight_rotation_sweep(BODY, R, Th, max_periods=20)
+    b = stability.eight_rotation_sweep(BODY, R, Th, max_periods=20, engine="numpy")  # amplify rounding)
+    np.testing.assert_array_equal(a.R, R)
+    np.testing.assert_array_equal(a.Theta, Th)
+    np.testing.assert_allclose(a["range"], b["range"], atol=1e-9)
+    assert list(a.regime) == list(b.regime)
+
+
+def test_classification_on_constructed_cases():
+    n = 64
+    s = 2 * np.pi * np.arange(1, n + 1) / n
+    periods = np.arange(5)[:, None]
+    periodic = np.broadcast_to(0.3 * np.sin(s), (5, n))
+    slipping = 0.3 * np.sin(s) - 2 * np.pi * (periods + s / (2 * np.pi))
+    period2 = 0.3 * np.sin(s) + 0.1 * np.cos(s / 2 + np.pi * periods)
+    rng = np.random.default_rng(0)
+    irregular = rng.normal(size=(5, n))
+    P = np.stack([periodic, slipping, period2, irregular], axis=1)
+    c = stability.classify_samples(P, tol=1e-9)
+    assert list(c["regime"]) == ["periodic", "slipping", "periodic", "irregular"]
+    assert list(c["period"][:3]) == [1, 1, 2]
+    assert c["slip"][1] == -1
+    assert c["range"][0] == pytest.approx(0.6, rel=1e-2)
+
+
+@pytest.mark.parametrize("R, Th", [([-1.0], [0.5]), ([1.0], [0.0]), ([], []), ([1.0, 2.0], [0.5]),
+                                   ([[1.0]], [[0.5]]), ([np.nan], [0.5])])
+def test_sweep_rejects_bad_input(R, Th):
+    with pytest.raises(ValueError):
+        stability.eight_rotation_sweep(BODY, R, Th)
+
+
+def test_heading_fourier_matches_paper_series_to_printed_digits():
+    a = stability.eight_heading_fourier(7)
+    for k, printed in stability.PAPER_HEADING_SERIES.items():
+        assert a[k] == pytest.approx(printed, abs=0.006)
+    np.testing.assert_allclose(a[[2, 4, 6]], 0.0, atol=1e-12)   # only odd harmonics
+
+
+def test_slipping_coexists_only_near_critical_radius_at_high_rate():
+    r_crit = stability.circle_critical_radius(BODY, 1.5)
+    coexists = stability.circle_slipping_coexists(BODY, r_crit * np.array([1.05, 3.0]), 1.5)
+    assert list(coexists) == [True, False]
+    # a slipping motion from a fast initial spin confirms the coexistence at 1.05 R_crit
+    df = stability.circle_final_state(BODY, 1.05 * r_crit, 1.5, 0.0, [-6.0, 0.0], t_end=300.0)
+    assert set(df.regime) == {"slipping", "settled"}
