@@ -35,9 +35,9 @@ __all__ = [
     "RotationEquation", "derive_rotation_equation", "printed_eq33", "derive_eight_equation",
     "printed_eq37", "circle_equilibria", "circle_critical_radius", "circle_eigenvalues",
     "circle_jacobian", "circle_rotation_rhs", "circle_final_state", "circle_slipping_coexists",
-    "steps_per_period", "reduced_rotation", "classify_samples", "rotation_sweep", "eight_rotation_sweep",
+    "steps_per_period", "reduced_rotation", "classify_samples", "sampled_range", "rotation_sweep", "eight_rotation_sweep",
     "eight_heading_fourier", "heading_series", "PAPER_HEADING_SERIES", "ENGINES", "corrected_p0",
-    "printed_p0", "ERRATA",
+    "printed_p0", "plot_fig5", "plot_circle_map", "ERRATA",
 ]
 
 
@@ -268,7 +268,7 @@ def _coefficients(body: Body, R, Theta):
     return A, B, C
 
 
-def steps_per_period(body: Body, kind: str, R, Theta, h_lambda: float = 0.25) -> np.ndarray:
+def steps_per_period(body: Body, kind: str, R, Theta, h_lambda: float = 0.125) -> np.ndarray:
     """Fixed steps per reference period for each point: a power of two (>= 64)
     such that h Lambda <= ``h_lambda``, where Lambda = A + sqrt(B v_max + C a_max)
     bounds the moduli of the eigenvalues of the linearised equation (in s)."""
@@ -305,13 +305,13 @@ def _forcing(kind: str, n: int):
     at, winding = _shape(kind)
     h = 2 * np.pi / n
     X1, Y1, X2, Y2, _, _ = at((np.arange(n)[:, None] + Cc[None, :]) * h)
-    _, _, _, _, H, _ = at(np.arange(1, n + 1) * h)
-    return h, X1, Y1, X2, Y2, H, winding
+    _, _, _, _, H, H1 = at(np.arange(1, n + 1) * h)
+    return h, X1, Y1, X2, Y2, (H, H1), winding
 
 
 def _period(phi, w, A, B, C, h, X1, Y1, X2, Y2):
-    """One reference period of fixed DOP853 steps for all points; returns (phi at
-    every step end, shape (n, N), final phi, final w)."""
+    """One reference period of fixed DOP853 steps for all points; returns ((phi, w)
+    at every step end, each of shape (n, N)), final phi, final w)."""
     Aa, Bb, Cc = _tableau()
     n, stages = X1.shape
     hA = Aa * h
@@ -319,6 +319,7 @@ def _period(phi, w, A, B, C, h, X1, Y1, X2, Y2):
     KP = np.empty((stages,) + phi.shape)
     KW = np.empty_like(KP)
     out = np.empty((n,) + phi.shape)
+    out_w = np.empty_like(out)
     for j in range(n):
         for i in range(stages):
             if i == 0:
@@ -331,15 +332,16 @@ def _period(phi, w, A, B, C, h, X1, Y1, X2, Y2):
         phi = phi + hB @ KP
         w = w + hB @ KW
         out[j] = phi
-    return out, phi, w
+        out_w[j] = w
+    return (out, out_w), phi, w
 
 
-def _period_compiled_impl(phi, w, A, B, C, h, X1, Y1, X2, Y2, hA, hB, out):
+def _period_compiled_impl(phi, w, A, B, C, h, X1, Y1, X2, Y2, hA, hB, out, out_w):
     """Same scheme as :func:`_period`, one point at a time in compiled loops."""
     n, stages = X1.shape
-    kp = np.empty(stages)
-    kw = np.empty(stages)
-    for q in range(phi.size):
+    for q in _prange(phi.size):
+        kp = np.empty(stages)
+        kw = np.empty(stages)
         f, v, a_, b_, c_ = phi[q], w[q], A[q], B[q], C[q]
         for j in range(n):
             for i in range(stages):
@@ -354,25 +356,32 @@ def _period_compiled_impl(phi, w, A, B, C, h, X1, Y1, X2, Y2, hA, hB, out):
                 f += hB[i] * kp[i]
                 v += hB[i] * kw[i]
             out[j, q] = f
+            out_w[j, q] = v
         phi[q], w[q] = f, v
 
 
 _COMPILED = None
 
 
+def _prange(n):  # the plain-Python stand-in; rebound to numba.prange before compiling
+    return range(n)
+
+
 def _period_compiled(phi, w, A, B, C, h, X1, Y1, X2, Y2):
     """:func:`_period` compiled with numba (the default engine; see the benchmark)."""
-    global _COMPILED
+    global _COMPILED, _prange
     if _COMPILED is None:
         import numba
 
-        _COMPILED = numba.njit(cache=True, fastmath=False)(_period_compiled_impl)
+        _prange = numba.prange
+        _COMPILED = numba.njit(cache=True, parallel=True)(_period_compiled_impl)
     Aa, Bb, _ = _tableau()
     phi, w = np.array(phi, dtype=float), np.array(w, dtype=float)
     out = np.empty((X1.shape[0], phi.size))
+    out_w = np.empty_like(out)
     _COMPILED(phi, w, np.ascontiguousarray(A, float), np.ascontiguousarray(B, float),
-              np.ascontiguousarray(C, float), h, X1, Y1, X2, Y2, Aa * h, Bb * h, out)
-    return out, phi, w
+              np.ascontiguousarray(C, float), h, X1, Y1, X2, Y2, Aa * h, Bb * h, out, out_w)
+    return (out, out_w), phi, w
 
 
 ENGINES = {"numba": _period_compiled, "numpy": _period}
@@ -391,12 +400,12 @@ def _run(body, kind, R, Theta, n, periods, p0, v0, record=False):
     phi, w = _initial(kind, Theta, p0, v0)
     outs = [phi[None].copy()]
     for _ in range(periods):
-        out, phi, w = _period(phi, w, A, B, C, h, X1, Y1, X2, Y2)
+        (out, _), phi, w = _period(phi, w, A, B, C, h, X1, Y1, X2, Y2)
         outs.append(out)
     return np.concatenate(outs), w
 
 
-def classify_samples(P: np.ndarray, tol: float = 1e-9) -> dict:
+def classify_samples(P: np.ndarray, tol: float = 1e-9, dP: np.ndarray | None = None) -> dict:
     """Classify the steady state from the rotation error sampled over the last periods.
 
     ``P`` has shape (L_max + 1, N, n): for N points, the last L_max + 1 reference
@@ -407,7 +416,9 @@ def classify_samples(P: np.ndarray, tol: float = 1e-9) -> dict:
     ``periodic``, k_L != 0 ``slipping``; if no lag qualifies it is ``irregular``
     (the smallest defect is reported). Returns arrays: regime, period, slip
     (turns per reference period), defect, range (max - min of p over the last
-    ``period`` periods).
+    ``period`` periods; with the phase derivatives ``dP`` = dp/ds at the same
+    samples, the extremes are refined by cubic Hermite interpolation, see
+    :func:`sampled_range`).
     """
     P = np.asarray(P, dtype=float)
     if P.ndim != 3 or P.shape[0] < 2 or P.shape[2] < 1:
@@ -432,13 +443,64 @@ def classify_samples(P: np.ndarray, tol: float = 1e-9) -> dict:
     for L in np.unique(period):
         sel = period == L
         window = P[-L:, sel, :].transpose(1, 0, 2).reshape(sel.sum(), -1)
-        rng[sel] = window.max(axis=1) - window.min(axis=1)
+        dwin = None if dP is None else dP[-L:, sel, :].transpose(1, 0, 2).reshape(sel.sum(), -1)
+        rng[sel] = sampled_range(window, cyclic=(k[sel] == 0), dy=dwin, h=2 * np.pi / P.shape[2])
     return dict(regime=regime, period=period, slip=k / period, defect=defects[Lidx, cols], range=rng)
+
+
+def sampled_range(y, cyclic=True, dy=None, h: float = 1.0) -> np.ndarray:
+    """max - min of each row of ``y`` (samples at equal phase steps ``h``).
+
+    Without ``dy`` the extreme samples are refined by the parabola through them
+    and their neighbours (error O(h^3)); with the derivatives ``dy`` (per unit
+    phase) at the samples, by the cubic Hermite interpolant on the two
+    intervals beside each extreme sample (error O(h^4)), so that the range is
+    that of the continuous signal, not of its sampling. ``cyclic`` (per row) lets
+    neighbours wrap around, as for whole periods of a periodic signal;
+    otherwise extremes at the ends are not refined."""
+    y = np.atleast_2d(np.asarray(y, dtype=float))
+    n = y.shape[1]
+    if n < 3:
+        return y.max(axis=1) - y.min(axis=1)
+    cyclic = np.broadcast_to(np.asarray(cyclic, bool), y.shape[:1])
+    rows = np.arange(y.shape[0])
+
+    def parabola(j, sign):
+        ym, y0, yp = y[rows, (j - 1) % n], y[rows, j], y[rows, (j + 1) % n]
+        curv = ym - 2 * y0 + yp
+        ok = (cyclic | ((j > 0) & (j < n - 1))) & (sign * curv < 0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            val = y0 - (ym - yp) ** 2 / (8 * curv)
+        return np.where(ok, val, y0)
+
+    def hermite(j, sign):
+        best = y[rows, j] * sign
+        for a in (j - 1, j):
+            b = a + 1
+            ok = cyclic | ((a >= 0) & (b <= n - 1))
+            a, b = a % n, b % n
+            y0, y1 = y[rows, a] * sign, y[rows, b] * sign
+            d0, d1 = dy[rows, a] * h * sign, dy[rows, b] * h * sign
+            c1, c2, c3 = d0, 3 * (y1 - y0) - 2 * d0 - d1, 2 * (y0 - y1) + d0 + d1
+            disc = np.maximum(c2**2 - 3 * c1 * c3, 0.0)
+            for root in ((-c2 + np.sqrt(disc)), (-c2 - np.sqrt(disc))):
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    t = np.where(np.abs(c3) > 1e-300, root / (3 * c3), -c1 / (2 * c2))
+                inside = ok & np.isfinite(t) & (t > 0) & (t < 1)
+                t = np.where(inside, t, 0.0)
+                val = y0 + t * (c1 + t * (c2 + t * c3))
+                best = np.where(inside, np.maximum(best, val), best)
+        return best * sign
+
+    if dy is None:
+        return parabola(y.argmax(axis=1), 1) - parabola(y.argmin(axis=1), -1)
+    dy = np.atleast_2d(np.asarray(dy, dtype=float))
+    return hermite(y.argmax(axis=1), 1) - hermite(y.argmin(axis=1), -1)
 
 
 def rotation_sweep(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, tol: float = 1e-9,
                    min_periods: int = 4, max_periods: int = 200, max_lag: int = 4,
-                   h_lambda: float = 0.25, steps: int | None = None, engine: str = "numba") -> pd.DataFrame:
+                   h_lambda: float = 0.125, steps: int | None = None, engine: str = "numba") -> pd.DataFrame:
     """Steady state of the rotation error p = phi - phi_d on the reference ``kind``
     (``"eight"`` or ``"circle"``) for every grid point (R_i, Theta_i), started on the
     reference with p(0) = ``p0`` (rad) and dp/dt(0) = ``v0`` (rad/s) (scalars or arrays).
@@ -483,17 +545,19 @@ def rotation_sweep(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, tol: floa
             for k in ("range", "regime", "period", "slip", "defect", "periods")}
     for n in np.unique(n_pts):
         idx = np.flatnonzero(n_pts == n)
-        h, X1, Y1, X2, Y2, H, winding = _forcing(kind, int(n))
+        h, X1, Y1, X2, Y2, (H, H1), winding = _forcing(kind, int(n))
         A, B, C = _coefficients(body, R[idx], Theta[idx])
         phi, w = _initial(kind, Theta[idx], p0[idx], v0[idx])
         P = np.zeros((max_lag + 1, idx.size, int(n)))
+        dP = np.zeros_like(P)
         for k in range(1, max_periods + 1):
-            out, phi, w = step_period(phi, w, A, B, C, h, X1, Y1, X2, Y2)
-            P = np.roll(P, -1, axis=0)
+            (out, out_w), phi, w = step_period(phi, w, A, B, C, h, X1, Y1, X2, Y2)
+            P, dP = np.roll(P, -1, axis=0), np.roll(dP, -1, axis=0)
             P[-1] = (out - H[:, None] - 2 * np.pi * winding * (k - 1)).T
+            dP[-1] = (out_w - H1[:, None]).T
             if k < max(min_periods, max_lag + 1) and k < max_periods:
                 continue
-            c = classify_samples(P[-(min(k, max_lag) + 1):], tol)
+            c = classify_samples(P[-(min(k, max_lag) + 1):], tol, dP[-(min(k, max_lag) + 1):])
             done = (c["defect"] <= tol) | (k == max_periods)
             for key in ("range", "regime", "period", "slip", "defect"):
                 cols[key][idx[done]] = c[key][done]
@@ -501,7 +565,8 @@ def rotation_sweep(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, tol: floa
             keep = ~done
             if not keep.any():
                 break
-            idx, phi, w, A, B, C, P = idx[keep], phi[keep], w[keep], A[keep], B[keep], C[keep], P[:, keep]
+            idx, phi, w, A, B, C = idx[keep], phi[keep], w[keep], A[keep], B[keep], C[keep]
+            P, dP = P[:, keep], dP[:, keep]
     frame = pd.DataFrame({"R": R, "Theta": Theta, **cols, "steps": n_pts})
     return frame.astype({"period": int, "periods": int, "range": float, "slip": float, "defect": float})
 
@@ -530,38 +595,54 @@ def _circle_arrays(body, R, theta, *arrays):
 
 
 def circle_final_state(body: Body, R, theta, p0=0.0, v0=0.0, t_end: float = 300.0,
-                       rtol: float = 1e-9, atol: float = 1e-9) -> pd.DataFrame:
+                       t_max: float = 5000.0, rtol: float = 1e-9, atol: float = 1e-9) -> pd.DataFrame:
     """Integrate the corrected (33) from p(0) = ``p0`` (rad), p'(0) = ``v0`` (rad/s)
-    for ``t_end`` s, for all broadcast (R, theta, p0, v0) together (one stacked
-    ``solve_ivp``). Returns a DataFrame with R, theta, p0, v0, p_end, v_end and
-    ``regime``: ``settled`` if the end state is within 1e-4 of the stable
-    equilibrium (mod 2 pi) and at rest, else ``slipping`` (no equilibrium, or the
-    motion still turns)."""
+    for all broadcast (R, theta, p0, v0) together (one stacked ``solve_ivp`` per
+    stage) and classify the end state.
+
+    ``settled``: within 1e-4 of the stable equilibrium (mod 2 pi) and at rest;
+    ``slipping``: p changed by more than a whole turn over the second half of
+    the run; otherwise the run is extended, doubling its length, up to ``t_max``
+    s, after which the point is ``undecided``. Returns a DataFrame with R, theta,
+    p0, v0, p_end, v_end, t_end (s) and regime."""
     from scipy.integrate import solve_ivp
 
     R, theta, p0, v0 = _circle_arrays(body, R, theta, p0, v0)
     N = R.size
-
-    def rhs(t, y):
-        p, v = y[:N], y[N:]
-        return np.concatenate([v, circle_rotation_rhs(body, R, theta, p, v)])
-
-    sol = solve_ivp(rhs, (0.0, t_end), np.concatenate([p0, v0]), method="DOP853", rtol=rtol, atol=atol,
-                    t_eval=[t_end])
-    p_end, v_end = sol.y[:N, -1], sol.y[N:, -1]
-    gap = np.full(N, np.inf)
+    ps = np.full(N, np.nan)
     for i in range(N):
         try:
-            ps, _ = circle_equilibria(body, float(R[i]), float(theta[i]))
+            ps[i] = circle_equilibria(body, float(R[i]), float(theta[i]))[0]
         except ValueError:
-            continue
-        gap[i] = abs(math.remainder(p_end[i] - ps, 2 * math.pi))
-    settled = (gap < 1e-4) & (np.abs(v_end) < 1e-4)
-    return pd.DataFrame({"R": R, "theta": theta, "p0": p0, "v0": v0, "p_end": p_end, "v_end": v_end,
-                         "regime": np.where(settled, "settled", "slipping")})
+            pass
+    p, v = p0.copy(), v0.copy()
+    t_used = np.zeros(N)
+    regime = np.full(N, "undecided", dtype=object)
+    todo = np.arange(N)
+    span = float(t_end)
+    while todo.size and t_used[todo[0]] + span <= t_max + 1e-9:
+        Rr, th = R[todo], theta[todo]
+        n = todo.size
+
+        def rhs(t, y):
+            return np.concatenate([y[n:], circle_rotation_rhs(body, Rr, th, y[:n], y[n:])])
+
+        sol = solve_ivp(rhs, (0.0, span), np.concatenate([p[todo], v[todo]]), method="DOP853",
+                        rtol=rtol, atol=atol, t_eval=[span / 2, span])
+        mid, p[todo], v[todo] = sol.y[:n, 0], sol.y[:n, -1], sol.y[n:, -1]
+        t_used[todo] += span
+        gap = np.abs(np.remainder(p[todo] - ps[todo] + np.pi, 2 * np.pi) - np.pi)
+        settled = (gap < 1e-4) & (np.abs(v[todo]) < 1e-4)
+        slipping = ~settled & (np.abs(p[todo] - mid) > 2 * np.pi)
+        regime[todo[settled]] = "settled"
+        regime[todo[slipping]] = "slipping"
+        todo = todo[~(settled | slipping)]
+        span *= 2
+    return pd.DataFrame({"R": R, "theta": theta, "p0": p0, "v0": v0, "p_end": p, "v_end": v,
+                         "t_end": t_used, "regime": regime.astype(str)})
 
 
-def circle_slipping_coexists(body: Body, R, theta, t_end: float = 1000.0) -> np.ndarray:
+def circle_slipping_coexists(body: Body, R, theta, t_end: float = 400.0) -> np.ndarray:
     """Whether a slipping (running) motion of the corrected (33) coexists with the
     stable equilibrium, for each broadcast (R (m), theta (rad/s)) with R > R_crit.
 
@@ -593,7 +674,7 @@ def circle_slipping_coexists(body: Body, R, theta, t_end: float = 1000.0) -> np.
 
     sol = solve_ivp(rhs, (0.0, t_end), y0, method="DOP853", rtol=1e-10, atol=1e-12, dense_output=True)
     pmin = np.full(N, np.inf)
-    for chunk in np.array_split(np.linspace(0, t_end, 100001), 50):
+    for chunk in np.array_split(np.linspace(0, t_end, 40001), 10):
         pmin = np.minimum(pmin, sol.sol(chunk)[:N].min(axis=1))
     return pmin < ps - 2 * np.pi
 
@@ -725,3 +806,48 @@ def _errata():
 
 
 ERRATA = _errata()
+
+
+# ---------------------------------------------------------------- figures of Chapter 5
+
+def plot_fig5(frame: pd.DataFrame, ax=None):
+    """Fig. 5: steady-state range (rad) of the rotation error over (R, Theta), one
+    square per periodic point; slipping points as empty circles, irregular as crosses.
+    Returns the figure."""
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(7, 5))
+    fig = ax.figure
+    per = frame[frame.regime == "periodic"]
+    sc = ax.scatter(per.R, per.Theta, c=per["range"], marker="s", s=22, cmap="viridis", linewidths=0)
+    fig.colorbar(sc, ax=ax, label="range of $p$ (rad)")
+    slip = frame[frame.regime == "slipping"]
+    ax.scatter(slip.R, slip.Theta, facecolors="none", edgecolors="C3", s=30, label="slipping")
+    irr = frame[frame.regime == "irregular"]
+    ax.scatter(irr.R, irr.Theta, marker="x", color="k", s=14, lw=0.8, label="irregular")
+    ax.set(xlabel="R (m)", ylabel=r"$\Theta$ (rad/s)")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2)
+    return fig
+
+
+def plot_circle_map(frame: pd.DataFrame, body: Body, coexists=None, ax=None):
+    """Where the circle's rotation error settles or slips (``frame`` from
+    :func:`circle_final_state`), with the analytic boundary R_crit(theta) of (36)
+    and, if given, the points where slipping coexists with the stable equilibrium."""
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(7, 5))
+    for regime, style in (("settled", dict(color="C0", marker=".")), ("slipping", dict(color="C3", marker="x"))):
+        sel = frame[frame.regime == regime]
+        ax.scatter(sel.R, sel.theta, s=12, label=f"{regime} (from the reference)", **style)
+    if coexists is not None:
+        sel = frame[np.asarray(coexists, bool)]
+        ax.scatter(sel.R, sel.theta, s=60, facecolors="none", edgecolors="k",
+                   label="slipping coexists with $p_s$")
+    th = np.linspace(frame.theta.min(), frame.theta.max(), 300)
+    ax.plot([circle_critical_radius(body, x) for x in th], th, "k", lw=2, label=r"$R_{crit}(\theta)$, (36)")
+    ax.set(xlabel="R (m)", ylabel=r"$\theta$ (rad/s)")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2, fontsize=8)
+    return ax.figure

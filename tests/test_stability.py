@@ -68,8 +68,9 @@ def test_circle_functions_reject_bad_input(R, theta):
 def test_below_critical_radius_the_rotation_slips():
     theta = 1.0
     r_crit = stability.circle_critical_radius(BODY, theta)
-    df = stability.circle_final_state(BODY, [0.8 * r_crit, 2.0 * r_crit], theta, 0.0, 0.0, t_end=200.0)
-    assert list(df.regime) == ["slipping", "settled"]
+    df = stability.circle_final_state(BODY, [0.8 * r_crit, 0.99 * r_crit, 1.01 * r_crit, 2.0 * r_crit],
+                                      theta, 0.0, 0.0)
+    assert list(df.regime) == ["slipping", "slipping", "settled", "settled"]
 
 
 @pytest.mark.parametrize("kind, R, theta, dp0, dv0", [("eight", 2.0, math.pi / 4, 0.7, -0.3),
@@ -97,7 +98,12 @@ def test_sweep_matches_per_point_solve_ivp_on_full_closed_loop():
         res = simulate.simulate(BODY, Gains(), ref, float(t_last[-1]), z0=ref.z(0.0), dz0=ref.dz(0.0),
                                 t_eval=t_last)
         p = res.rotation_error()
-        assert row.range == pytest.approx(p.max() - p.min(), abs=1e-6)
+        dp_ds = (res.dz[:, 2] - res.dz_d[:, 2]) / row.Theta
+        r_ref = stability.sampled_range(p[None], dy=dp_ds[None], h=2 * math.pi / row.steps)[0]
+        assert row.range == pytest.approx(r_ref, abs=1e-6)
+        # and the refined range is that of the continuous signal: finer samples agree
+        fine = stability.eight_rotation_sweep(BODY, [row.R], [row.Theta], h_lambda=0.03)
+        assert fine["range"][0] == pytest.approx(row.range, abs=1e-6)
 
 
 def test_sweep_engines_agree_and_rows_keep_order():
@@ -132,6 +138,16 @@ def test_classification_on_constructed_cases():
 def test_sweep_rejects_bad_input(R, Th):
     with pytest.raises(ValueError):
         stability.eight_rotation_sweep(BODY, R, Th)
+
+
+def test_hermite_range_recovers_continuous_extremes():
+    s = np.linspace(0, 2 * np.pi, 65)[:-1]
+    y = np.sin(s + 0.3) + 0.2 * np.sin(3 * s)
+    dy = np.cos(s + 0.3) + 0.6 * np.cos(3 * s)
+    fine = np.linspace(0, 2 * np.pi, 200001)
+    exact = np.ptp(np.sin(fine + 0.3) + 0.2 * np.sin(3 * fine))
+    assert abs(np.ptp(y) - exact) > 1e-4                       # raw samples miss the extremes
+    assert stability.sampled_range(y[None], dy=dy[None], h=s[1])[0] == pytest.approx(exact, abs=1e-5)
 
 
 def test_heading_fourier_matches_paper_series_to_printed_digits():
