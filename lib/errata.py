@@ -20,7 +20,7 @@ from typing import Callable
 __all__ = ["Erratum", "Verdict", "rows", "table", "SOURCES"]
 
 #: modules that contribute rows, in the order of the paper's sections
-SOURCES: tuple[str, ...] = ("lib.symbolic", "lib.stability")
+SOURCES: tuple[str, ...] = ("lib.symbolic", "lib.tracking", "lib.stability")
 
 
 @dataclass(frozen=True)

@@ -53,6 +53,9 @@ class SimulationResult:
     beta: np.ndarray
     tau: np.ndarray
     ref: Reference
+    #: with ``switching="events"``: +1 / -1 the side of the angle-limit switching
+    #: surface, 0 sliding on it (see :class:`lib.limits.SwitchedLoop`); else None
+    mode: np.ndarray | None = None
 
     @property
     def error(self) -> np.ndarray:
@@ -109,7 +112,7 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
              force_limit: float | None = None, angle_limit: float | None = None,
              t_eval=None, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
              method: str = "DOP853", max_step: float = np.inf,
-             blowup: float = 1e8) -> SimulationResult:
+             blowup: float = 1e8, switching: str = "stepsize") -> SimulationResult:
     """Integrate the closed loop (2)-(4), (23), (25)-(26) from t = 0 to ``t_end`` (s).
 
     ``z0``, ``dz0``: initial configuration and rate (default: the paper's
@@ -118,6 +121,14 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
     ``t_eval``: output times (default: 20 per second). A state whose magnitude
     exceeds ``blowup`` or that becomes non-finite raises :class:`SimulationError`
     naming the time and the variable.
+
+    ``switching`` says how an angle limit's discontinuity is integrated:
+    ``"stepsize"`` (default) leaves it to the step-size control of one
+    ``solve_ivp`` run; ``"events"`` locates every crossing of the switching
+    surface and slides along it where the two sides push against each other
+    (Filippov), with :class:`lib.limits.SwitchedLoop`. ``"events"`` needs an
+    ``angle_limit`` below pi; in the result, ``beta`` while sliding is the
+    Filippov average angle and ``mode`` records the side.
     """
     if not isinstance(body, Body):
         raise TypeError(f"body must be a lib.params.Body, got {type(body).__name__}")
@@ -136,6 +147,11 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
         raise ValueError("t_eval must be a non-empty increasing 1-D array within [0, t_end]")
     # validate limits once, before integrating
     allocate(np.zeros(2), 0.0, force_limit, angle_limit)
+    if switching not in ("stepsize", "events"):
+        raise ValueError(f"switching must be 'stepsize' or 'events', got {switching!r}")
+    if switching == "events":
+        return _simulate_events(body, gains, ref, t_end, z0, dz0, force_limit, angle_limit, t_eval,
+                                rtol, atol, method, max_step)
 
     rhs = closed_loop_rhs(body, gains, ref, force_limit, angle_limit)
 
@@ -158,6 +174,22 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
     tau = computed_torque(body, gains, ref, t, z, dz)
     F, beta = allocate(tau, z[:, 2], force_limit, angle_limit)
     return SimulationResult(t=t, z=z, dz=dz, z_d=ref.z(t), dz_d=ref.dz(t), F=F, beta=beta, tau=tau, ref=ref)
+
+
+def _simulate_events(body, gains, ref, t_end, z0, dz0, force_limit, angle_limit, t_eval,
+                     rtol, atol, method, max_step) -> SimulationResult:
+    """``simulate(..., switching="events")``: event-located integration (lib.limits)."""
+    from .limits import SwitchedLoop
+
+    if angle_limit is None or angle_limit >= np.pi:
+        raise ValueError("switching='events' needs an angle_limit below pi (rad)")
+    loop = SwitchedLoop(body, gains, ref, angle_limit, force_limit)
+    seg = loop.integrate(np.concatenate([z0, dz0]), 0.0, float(t_end), t_eval=t_eval, rtol=rtol, atol=atol,
+                         method=method, max_step=max_step)
+    z, dz = seg.y[:, :3], seg.y[:, 3:]
+    tau = computed_torque(body, gains, ref, seg.t, z, dz)
+    return SimulationResult(t=seg.t, z=z, dz=dz, z_d=ref.z(seg.t), dz_d=ref.dz(seg.t), F=seg.F, beta=seg.beta,
+                            tau=tau, ref=ref, mode=seg.mode)
 
 
 OPEN_LOOP_FORMS = ("config", "state", "printed")

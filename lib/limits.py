@@ -1,0 +1,555 @@
+"""Force and angle limits (end of paper Sec. 5): an event-located integrator for
+the discontinuous closed loop, stroboscopic (Poincaré) sections, a largest
+Lyapunov exponent estimate and a classification of the long-run regime.
+
+Why a special integrator
+------------------------
+With an angle limit |beta| <= beta_max < pi, the position-only allocation
+(25)-(26) clips the force angle. When the demanded force (tau_x, tau_y) points
+straight behind the body, the clipped angle jumps from +beta_max to -beta_max:
+the right-hand side of the closed loop is discontinuous on the switching
+surface
+
+    S = {lat = 0, lon < 0},   lat = e1 x tau = tau_y cos(phi) - tau_x sin(phi),
+                              lon = e1 . tau = tau_x cos(phi) + tau_y sin(phi)
+
+(e1 the body axis). The rate of ``lat`` depends on the accelerations of x and y,
+which jump across S, so solutions can *slide* along S. :class:`SwitchedLoop`
+integrates such a system as Filippov {cite}`filippov1988` prescribes: smooth
+segments on either side, integrated with a smooth continuation of the side's
+vector field and ended by event location on lat = 0; at S, a crossing if both
+one-sided fields cross S in the same direction, otherwise sliding with the
+convex combination of the two fields that keeps the solution on S, until one
+of them turns away from S. The force cap F <= F_max only makes the field
+non-smooth (a kink), not discontinuous, and needs no special treatment.
+
+Lyapunov exponents follow Benettin et al. {cite}`benettin1980` with two
+trajectories renormalised once per period.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .params import Body, Gains
+from .trajectories import Circle, Eight, Reference
+
+__all__ = [
+    "SwitchedLoop", "Segments", "reference_kinematics", "error_state", "stroboscopic_section",
+    "largest_lyapunov", "LyapunovEstimate", "distinct_points", "classify", "Regime", "sweep_angle_limit",
+    "damped_oscillator_flow", "driven_pendulum_flow", "state_difference",
+]
+
+TWO_PI = 2.0 * math.pi
+
+
+# ------------------------------------------------------------------ reference
+
+
+def reference_kinematics(ref: Reference) -> Callable[[float], tuple]:
+    """Scalar function t -> (x_d, y_d, vx_d, vy_d, ax_d, ay_d, jx_d, jy_d) of the
+    reference position (m), velocity (m/s), acceleration (m/s^2) and jerk (m/s^3).
+
+    The jerk is needed for the rate of the switching function. For the circle
+    (27) and the eight (28) all four are exact; for another reference the jerk
+    is a fourth-order central difference of ``ref.ddz``.
+    """
+    if isinstance(ref, Circle):
+        R, th = ref.R, ref.theta
+
+        def kin(t: float) -> tuple:
+            s = th * t
+            c, sn = math.cos(s), math.sin(s)
+            return (R * c, R * sn, -R * th * sn, R * th * c, -R * th**2 * c, -R * th**2 * sn,
+                    R * th**3 * sn, -R * th**3 * c)
+        return kin
+    if isinstance(ref, Eight):
+        R, th = ref.R, ref.theta
+
+        def kin(t: float) -> tuple:
+            s = th * t
+            c1, s1, c2, s2 = math.cos(s), math.sin(s), math.cos(2 * s), math.sin(2 * s)
+            return (0.5 * R * s2, R * s1, R * th * c2, R * th * c1, -2 * R * th**2 * s2, -R * th**2 * s1,
+                    -4 * R * th**3 * c2, -R * th**3 * c1)
+        return kin
+
+    def kin(t: float) -> tuple:
+        h = 1e-3
+        z, dz, ddz = ref.z(t), ref.dz(t), ref.ddz(t)
+        j = (ref.ddz(t - 2 * h) - 8 * ref.ddz(t - h) + 8 * ref.ddz(t + h) - ref.ddz(t + 2 * h)) / (12 * h)
+        return (z[0], z[1], dz[0], dz[1], ddz[0], ddz[1], j[0], j[1])
+    return kin
+
+
+# ------------------------------------------------------------------ the switched loop
+
+
+@dataclass(frozen=True)
+class Segments:
+    """Output of :meth:`SwitchedLoop.integrate`.
+
+    ``t`` (s) shape (n,), ``y`` states [x, y, phi, xdot, ydot, phidot] shape (n, 6),
+    ``mode`` at each sample (+1 / -1: smooth on the side lat > 0 / lat < 0;
+    0: sliding on the switching surface), ``F`` (N) and ``beta`` (rad) the applied
+    force (while sliding, ``beta`` is the Filippov average angle
+    (2 lambda - 1) beta_max of the chattering between +-beta_max), the final
+    state ``y_end`` and mode ``mode_end`` at ``t_end``, and counts of surface
+    crossings and sliding episodes.
+    """
+
+    t: np.ndarray
+    y: np.ndarray
+    mode: np.ndarray
+    F: np.ndarray
+    beta: np.ndarray
+    t_end: float
+    y_end: np.ndarray
+    mode_end: int
+    n_crossings: int
+    n_slides: int
+    t_sliding: float
+
+
+class SwitchedLoop:
+    """Closed loop (2)-(4), (23), (25)-(26) with |beta| <= ``angle_limit`` (rad,
+    in (0, pi)) and optionally F <= ``force_limit`` (N), integrated with event
+    location at the switching surface and Filippov sliding (see the module
+    docstring). The state is s = [x, y, phi, xdot, ydot, phidot] (SI units).
+
+    ``k_slide`` (1/s) pulls a sliding solution back onto the surface
+    (lat' = -k_slide lat) against the drift of the integration error.
+    """
+
+    def __init__(self, body: Body, gains: Gains, ref: Reference, angle_limit: float,
+                 force_limit: float | None = None, *, k_slide: float = 5.0) -> None:
+        if not isinstance(body, Body) or not isinstance(gains, Gains):
+            raise TypeError("body and gains must be lib.params.Body and lib.params.Gains")
+        if not all(callable(getattr(ref, k, None)) for k in ("z", "dz", "ddz")):
+            raise TypeError(f"ref must be a reference with z, dz and ddz methods, got {type(ref).__name__}")
+        if (isinstance(angle_limit, bool) or not np.isscalar(angle_limit) or not np.isfinite(angle_limit)
+                or not 0 < angle_limit < math.pi):
+            raise ValueError(f"angle_limit must be a number in (0, pi) rad, got {angle_limit!r}")
+        if force_limit is not None and (isinstance(force_limit, bool) or not np.isscalar(force_limit)
+                                        or not np.isfinite(force_limit) or force_limit <= 0):
+            raise ValueError(f"force_limit must be a positive finite force in N, got {force_limit!r}")
+        self.body, self.gains, self.ref = body, gains, ref
+        self.bmax = float(angle_limit)
+        self.fmax = math.inf if force_limit is None else float(force_limit)
+        self.k_slide = float(k_slide)
+        self._kin = reference_kinematics(ref)
+        self.period = float(getattr(ref, "period", math.nan))
+
+    # -- pieces of the vector field (scalar, for speed) --
+
+    def _tau(self, t: float, s) -> tuple:
+        b, g = self.body, self.gains
+        xd, yd, vxd, vyd, axd, ayd, jxd, jyd = self._kin(t)
+        x, y, phi, vx, vy, w = s
+        tx = b.m * axd + b.c * vx + g.kv[0] * (vxd - vx) + g.kp[0] * (xd - x)
+        ty = b.m * ayd + b.c * vy + g.kv[1] * (vyd - vy) + g.kp[1] * (yd - y)
+        return tx, ty, (vxd, vyd, axd, ayd, jxd, jyd)
+
+    def _accel(self, s, F: float, beta: float) -> tuple:
+        b = self.body
+        phi, vx, vy, w = s[2], s[3], s[4], s[5]
+        return ((F * math.cos(phi + beta) - b.c * vx) / b.m,
+                (F * math.sin(phi + beta) - b.c * vy) / b.m,
+                (b.a * F * math.sin(beta) - b.c_phi * w) / b.I)
+
+    def lateral(self, t: float, s) -> float:
+        """Switching function lat = tau_y cos(phi) - tau_x sin(phi) (N)."""
+        tx, ty, _ = self._tau(t, s)
+        return ty * math.cos(s[2]) - tx * math.sin(s[2])
+
+    def _lat_rate(self, t: float, s, ax: float, ay: float, tx: float, ty: float, kin) -> float:
+        b, g = self.body, self.gains
+        vxd, vyd, axd, ayd, jxd, jyd = kin
+        x, y, phi, vx, vy, w = s
+        dtx = b.m * jxd + b.c * ax + g.kv[0] * (axd - ax) + g.kp[0] * (vxd - vx)
+        dty = b.m * jyd + b.c * ay + g.kv[1] * (ayd - ay) + g.kp[1] * (vyd - vy)
+        c, sn = math.cos(phi), math.sin(phi)
+        return dty * c - dtx * sn - w * (tx * c + ty * sn)
+
+    def _side(self, t: float, s, sigma: int) -> tuple:
+        """(F, beta) of the smooth field of side ``sigma``, continued across the surface."""
+        tx, ty, kin = self._tau(t, s)
+        c, sn = math.cos(s[2]), math.sin(s[2])
+        lat, lon = ty * c - tx * sn, tx * c + ty * sn
+        psi = math.atan2(lat, lon)
+        if lon < 0 and sigma * lat < 0:  # just across the surface: continue side sigma's field
+            psi += sigma * TWO_PI
+        beta = min(max(psi, -self.bmax), self.bmax)
+        return min(math.hypot(tx, ty), self.fmax), beta
+
+    def one_sided_rates(self, t: float, s) -> tuple[float, float]:
+        """Rates of ``lat`` under the fields with beta = +beta_max and beta = -beta_max."""
+        tx, ty, kin = self._tau(t, s)
+        F = min(math.hypot(tx, ty), self.fmax)
+        out = []
+        for beta in (self.bmax, -self.bmax):
+            ax, ay, _ = self._accel(s, F, beta)
+            out.append(self._lat_rate(t, s, ax, ay, tx, ty, kin))
+        return out[0], out[1]
+
+    def _sliding(self, t: float, s) -> tuple:
+        """(F, lambda, accelerations) of the Filippov sliding field."""
+        tx, ty, kin = self._tau(t, s)
+        F = min(math.hypot(tx, ty), self.fmax)
+        ap = self._accel(s, F, self.bmax)
+        am = self._accel(s, F, -self.bmax)
+        rp = self._lat_rate(t, s, ap[0], ap[1], tx, ty, kin)
+        rm = self._lat_rate(t, s, am[0], am[1], tx, ty, kin)
+        lat = ty * math.cos(s[2]) - tx * math.sin(s[2])
+        lam = (rm + self.k_slide * lat) / (rm - rp)
+        return F, lam, tuple(lam * p + (1 - lam) * m for p, m in zip(ap, am))
+
+    def rhs(self, t: float, s, mode: int) -> np.ndarray:
+        """Vector field of ``mode`` (+1, -1: smooth side; 0: sliding)."""
+        if mode == 0:
+            acc = self._sliding(t, s)[2]
+        else:
+            acc = self._accel(s, *self._side(t, s, mode))
+        return np.array([s[3], s[4], s[5], acc[0], acc[1], acc[2]])
+
+    def inputs(self, t: float, s, mode: int) -> tuple[float, float]:
+        """Applied (F (N), beta (rad)); while sliding, beta is the Filippov average."""
+        if mode == 0:
+            F, lam, _ = self._sliding(t, s)
+            return F, (2 * lam - 1) * self.bmax
+        return self._side(t, s, mode)
+
+    def initial_mode(self, t: float, s) -> int:
+        """Mode of a state: the side of the surface it lies on, or 0 if it lies on
+        the surface (|lat| < 1e-12 N behind the body) where the flow slides."""
+        tx, ty, _ = self._tau(t, s)
+        c, sn = math.cos(s[2]), math.sin(s[2])
+        lat, lon = ty * c - tx * sn, tx * c + ty * sn
+        if abs(lat) < 1e-12 and lon < 0:
+            rp, rm = self.one_sided_rates(t, s)
+            if rp < 0 < rm:
+                return 0
+            return 1 if rp > 0 else -1
+        return 1 if lat >= 0 else -1
+
+    # -- integration --
+
+    def integrate(self, s0, t0: float, t1: float, t_eval=None, *, mode: int | None = None,
+                  rtol: float = 1e-9, atol: float = 1e-9, method: str = "DOP853",
+                  max_step: float = np.inf, max_segments: int = 200_000) -> Segments:
+        """Integrate from (t0, s0) to t1 (s), sampling at ``t_eval`` (default: t0 and t1).
+
+        ``mode`` is the starting mode (default :meth:`initial_mode`). Raises
+        ``RuntimeError`` if more than ``max_segments`` smooth pieces are needed
+        (a Zeno-like accumulation of switchings).
+        """
+        s = np.asarray(s0, dtype=float)
+        if s.shape != (6,) or not np.all(np.isfinite(s)):
+            raise ValueError(f"s0 must be a finite state of shape (6,), got {s0!r}")
+        if not t1 > t0:
+            raise ValueError(f"need t1 > t0, got t0 = {t0!r}, t1 = {t1!r}")
+        tev = np.array([t0, t1]) if t_eval is None else np.asarray(t_eval, dtype=float)
+        if tev.ndim != 1 or tev.size == 0 or tev[0] < t0 or tev[-1] > t1 or np.any(np.diff(tev) <= 0):
+            raise ValueError("t_eval must be a non-empty increasing 1-D array within [t0, t1]")
+        mode = self.initial_mode(t0, s) if mode is None else int(mode)
+        ts, ys, ms = [], [], []
+        t = float(t0)
+        first = True
+        n_cross = n_slide = 0
+        t_slide = 0.0
+        for _ in range(max_segments):
+            sel = tev[(tev >= t) if first else (tev > t)]
+            first = False
+            want_end = sel.size > 0 and sel[-1] == t1
+            if not want_end:
+                sel = np.append(sel, t1)  # always return the state at t1
+            fun, events = self._segment(mode)
+            sol = solve_ivp(fun, (t, t1), s, method=method, t_eval=sel, rtol=rtol, atol=atol,
+                            max_step=max_step, events=events)
+            if sol.status == -1:
+                raise RuntimeError(f"integration failed at t = {t:.6g} s: {sol.message}")
+            st = np.asarray(sol.t, dtype=float).reshape(-1)
+            sy = np.asarray(sol.y, dtype=float).reshape(6, -1).T
+            keep = slice(None) if (want_end or sol.status == 1) else slice(0, -1)
+            ts.append(st[keep])
+            ys.append(sy[keep])
+            ms.append(np.full(st[keep].size, mode))
+            if sol.status == 0:
+                if mode == 0:
+                    t_slide += t1 - t
+                t, s = t1, sy[-1]
+                break
+            k = next(i for i, te in enumerate(sol.t_events) if te.size)
+            t_new, s = float(sol.t_events[k][0]), sol.y_events[k][0]
+            if mode == 0:
+                t_slide += t_new - t
+            t = t_new
+            mode, crossed, slid = self._after_event(t, s, mode, k)
+            n_cross += crossed
+            n_slide += slid
+        else:
+            raise RuntimeError(f"more than {max_segments} switching segments before t = {t1} s "
+                               f"(stopped at t = {t:.6g} s)")
+        t_all = np.concatenate(ts)
+        y_all = np.concatenate(ys) if ys else np.empty((0, 6))
+        m_all = np.concatenate(ms).astype(int)
+        FB = np.array([self.inputs(ti, yi, mi) for ti, yi, mi in zip(t_all, y_all, m_all)]).reshape(-1, 2)
+        return Segments(t=t_all, y=y_all, mode=m_all, F=FB[:, 0], beta=FB[:, 1], t_end=float(t),
+                        y_end=np.array(s, dtype=float), mode_end=int(mode), n_crossings=n_cross,
+                        n_slides=n_slide, t_sliding=t_slide)
+
+    def _segment(self, mode: int):
+        if mode == 0:
+            def fun(t, s):
+                return self.rhs(t, s, 0)
+
+            def exit_plus(t, s):  # lambda -> 1: the + field leaves the surface
+                rp, _ = self.one_sided_rates(t, s)
+                return rp + self.k_slide * self.lateral(t, s)
+
+            def exit_minus(t, s):  # lambda -> 0: the - field leaves the surface
+                _, rm = self.one_sided_rates(t, s)
+                return rm + self.k_slide * self.lateral(t, s)
+
+            exit_plus.terminal, exit_plus.direction = True, 1
+            exit_minus.terminal, exit_minus.direction = True, -1
+            return fun, [exit_plus, exit_minus]
+
+        def fun(t, s):
+            return self.rhs(t, s, mode)
+
+        def hit(t, s):
+            return self.lateral(t, s)
+
+        hit.terminal, hit.direction = True, -mode
+        return fun, [hit]
+
+    def _after_event(self, t: float, s, mode: int, k: int) -> tuple[int, int, int]:
+        """New mode after an event, and whether it was a crossing / the start of a slide."""
+        if mode == 0:
+            return (1 if k == 0 else -1), 0, 0
+        tx, ty, _ = self._tau(t, s)
+        lon = tx * math.cos(s[2]) + ty * math.sin(s[2])
+        if lon >= 0:  # demand straight ahead: beta passes through 0 smoothly
+            return -mode, 0, 0
+        rp, rm = self.one_sided_rates(t, s)
+        far = rm if mode == 1 else rp
+        if mode * far < 0:  # the far side carries on away from the surface: cross
+            return -mode, 1, 0
+        return 0, 0, 1
+
+    # -- stroboscopic map --
+
+    def flow(self, s, t0: float, t1: float, mode: int | None = None, **kw) -> tuple[np.ndarray, int]:
+        """State and mode at t1 starting from state ``s`` (and ``mode``) at t0."""
+        seg = self.integrate(s, t0, t1, mode=mode, **kw)
+        return seg.y_end, seg.mode_end
+
+
+# ------------------------------------------------------------------ sections and exponents
+
+
+def state_difference(a, b) -> np.ndarray:
+    """a - b for states [x, y, phi, xdot, ydot, phidot] with the phi entry wrapped to (-pi, pi]."""
+    d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
+    d[..., 2] = np.pi - np.mod(np.pi - d[..., 2], TWO_PI)
+    return d
+
+
+def error_state(ref: Reference, t, y) -> np.ndarray:
+    """Tracking errors of states ``y`` (n, 6) at times ``t``: columns
+    [e_x (m), e_y (m), de_x (m/s), de_y (m/s), p (rad), dp (rad/s)] with
+    e = z_d - z as in (24) and the rotation error p = phi - phi_d wrapped to (-pi, pi]."""
+    t = np.asarray(t, dtype=float)
+    y = np.atleast_2d(np.asarray(y, dtype=float))
+    zd, dzd = ref.z(t), ref.dz(t)
+    p = y[:, 2] - zd[:, 2]
+    p = np.pi - np.mod(np.pi - p, TWO_PI)
+    return np.column_stack([zd[:, 0] - y[:, 0], zd[:, 1] - y[:, 1], dzd[:, 0] - y[:, 3], dzd[:, 1] - y[:, 4],
+                            p, y[:, 5] - dzd[:, 2]])
+
+
+def stroboscopic_section(loop: SwitchedLoop, s0, n_transient: int, n_points: int, **kw) -> np.ndarray:
+    """Poincaré section of the period-T map: the error state (see :func:`error_state`)
+    at t = k T for k = n_transient, ..., n_transient + n_points - 1, T the
+    reference period. Returns an array of shape (n_points, 6)."""
+    if n_points < 1 or n_transient < 0:
+        raise ValueError("need n_points >= 1 and n_transient >= 0")
+    T = loop.period
+    k = np.arange(n_transient, n_transient + n_points)
+    seg = loop.integrate(s0, 0.0, float(k[-1] * T), t_eval=k * T, **kw)
+    return error_state(loop.ref, seg.t, seg.y)
+
+
+def distinct_points(points, tol: float) -> int:
+    """Number of clusters of ``points`` (n, d) whose members lie within ``tol`` of
+    the cluster's first point (max-norm); a period-k orbit of the map gives k."""
+    pts = np.atleast_2d(np.asarray(points, dtype=float))
+    if pts.shape[0] == 0:
+        raise ValueError("points must not be empty")
+    reps: list[np.ndarray] = []
+    for p in pts:
+        if not any(np.max(np.abs(p - r)) <= tol for r in reps):
+            reps.append(p)
+    return len(reps)
+
+
+@dataclass(frozen=True)
+class LyapunovEstimate:
+    """Largest Lyapunov exponent (1/s) with its standard error over the renormalisation
+    intervals, and the running estimate after each interval."""
+
+    value: float
+    stderr: float
+    running: np.ndarray
+
+
+def largest_lyapunov(flow: Callable, x0, dt: float, n_steps: int, *, d0: float = 1e-8,
+                     n_transient: int = 0, difference: Callable | None = None,
+                     direction=None) -> LyapunovEstimate:
+    """Largest Lyapunov exponent by two nearby trajectories renormalised every ``dt`` (Benettin).
+
+    ``flow(x, t0, t1)`` maps a state at t0 to t1 (it may carry extra state, e.g.
+    a switching mode, as the second item of a tuple ``(x, extra)``: then
+    ``x0`` is such a tuple too). After ``n_transient`` intervals the companion
+    starts at distance ``d0`` along ``direction`` (default: all components
+    equal); after each interval its separation d is measured with
+    ``difference`` (default a - b), log(d / d0) recorded, and the companion
+    pulled back to distance d0 along the separation.
+    Returns the mean of log(d/d0)/dt and its standard error.
+    """
+    if dt <= 0 or n_steps < 2 or d0 <= 0:
+        raise ValueError("need dt > 0, n_steps >= 2 and d0 > 0")
+    diff = difference or (lambda a, b: np.asarray(a, float) - np.asarray(b, float))
+    carry = isinstance(x0, tuple)
+    state = x0
+    t = 0.0
+    for _ in range(n_transient):
+        state = flow(state[0], t, t + dt, state[1]) if carry else flow(state, t, t + dt)
+        t += dt
+    x = np.asarray(state[0] if carry else state, dtype=float)
+    u = np.ones_like(x) if direction is None else np.asarray(direction, dtype=float)
+    u = u / np.linalg.norm(u)
+    y = x + d0 * u
+    extra_x = state[1] if carry else None
+    extra_y = None
+    logs = np.empty(n_steps)
+    for i in range(n_steps):
+        if carry:
+            x, extra_x = flow(x, t, t + dt, extra_x)
+            y, extra_y = flow(y, t, t + dt, None)
+        else:
+            x, y = flow(x, t, t + dt), flow(y, t, t + dt)
+        t += dt
+        d = diff(y, x)
+        dn = float(np.linalg.norm(d))
+        if not np.isfinite(dn) or dn == 0:
+            raise RuntimeError(f"separation became {dn} at t = {t:.6g}")
+        logs[i] = math.log(dn / d0)
+        y = np.asarray(x, dtype=float) + d * (d0 / dn)
+    rates = logs / dt
+    return LyapunovEstimate(value=float(rates.mean()), stderr=float(rates.std(ddof=1) / math.sqrt(n_steps)),
+                            running=np.cumsum(logs) / (dt * np.arange(1, n_steps + 1)))
+
+
+def damped_oscillator_flow(zeta: float = 0.1, omega: float = 1.0) -> Callable:
+    """Flow of x'' + 2 zeta omega x' + omega^2 x = 0 (exact, via the matrix exponential);
+    its Lyapunov exponents are -zeta omega (twice, for zeta < 1)."""
+    from scipy.linalg import expm
+
+    A = np.array([[0.0, 1.0], [-omega**2, -2 * zeta * omega]])
+
+    def flow(x, t0, t1):
+        return expm(A * (t1 - t0)) @ np.asarray(x, dtype=float)
+    return flow
+
+
+def driven_pendulum_flow(q: float = 2.0, g: float = 1.5, omega_d: float = 2.0 / 3.0,
+                         rtol: float = 1e-10, atol: float = 1e-10) -> Callable:
+    """Flow of the driven damped pendulum of Baker & Gollub {cite}`baker1996`,
+    theta'' + theta'/q + sin(theta) = g cos(omega_d t), state (theta, theta').
+    Their q = 2, g = 1.5, omega_d = 2/3 is chaotic."""
+
+    def rhs(t, x):
+        return [x[1], -x[1] / q - math.sin(x[0]) + g * math.cos(omega_d * t)]
+
+    def flow(x, t0, t1):
+        return solve_ivp(rhs, (t0, t1), x, method="DOP853", rtol=rtol, atol=atol).y[:, -1]
+    return flow
+
+
+# ------------------------------------------------------------------ regimes
+
+
+@dataclass(frozen=True)
+class Regime:
+    """Long-run behaviour at one angle limit: the stroboscopic section, the number of
+    distinct section points (0 means "more than ``max_period``"), the largest
+    Lyapunov exponent (1/s) with its standard error, and the verdict."""
+
+    angle_limit: float
+    section: np.ndarray
+    n_distinct: int
+    lyapunov: float
+    lyapunov_stderr: float
+    verdict: str
+    n_crossings: int
+    t_sliding: float
+
+
+def classify(n_distinct: int, lyapunov: float, stderr: float, *, max_period: int = 8,
+             zero_band: float = 0.01) -> str:
+    """Verdict from a section and an exponent (1/s).
+
+    "periodic-k" when the section has k <= ``max_period`` distinct points (and the
+    exponent is not significantly positive); "chaotic" when the exponent exceeds
+    both ``zero_band`` and three standard errors; otherwise "quasi-periodic"
+    when it is within ``zero_band`` of zero, and "undecided" when the two tests disagree.
+    """
+    significant = lyapunov > max(zero_band, 3 * stderr)
+    if 0 < n_distinct <= max_period and not significant:
+        return f"periodic-{n_distinct}"
+    if significant:
+        return "chaotic"
+    if abs(lyapunov) <= zero_band + 3 * stderr:
+        return "quasi-periodic"
+    return "undecided"
+
+
+def sweep_angle_limit(body: Body, gains: Gains, ref: Reference, angle_limits, *, force_limit=None,
+                      n_transient: int = 30, n_points: int = 40, n_lyap: int = 40, tol: float = 1e-4,
+                      rtol: float = 1e-10, atol: float = 1e-10, d0: float = 1e-5, z0=None, dz0=None) -> list[Regime]:
+    """Classify the long-run regime for each angle limit (rad).
+
+    For each limit: ``n_transient`` periods are discarded, ``n_points`` section
+    points recorded (distinct up to ``tol`` in the max-norm of the error state),
+    and the largest Lyapunov exponent estimated over ``n_lyap`` periods starting
+    from the end of the section.
+    """
+    from .params import PAPER_DZ0, PAPER_Z0
+
+    z0 = np.asarray(PAPER_Z0 if z0 is None else z0, dtype=float)
+    dz0 = np.asarray(PAPER_DZ0 if dz0 is None else dz0, dtype=float)
+    out = []
+    for bmax in np.atleast_1d(np.asarray(angle_limits, dtype=float)):
+        loop = SwitchedLoop(body, gains, ref, float(bmax), force_limit)
+        T = loop.period
+        k = np.arange(n_transient, n_transient + n_points)
+        seg = loop.integrate(np.concatenate([z0, dz0]), 0.0, float(k[-1] * T), t_eval=k * T, rtol=rtol, atol=atol)
+        sec = error_state(ref, seg.t, seg.y)
+        n_dist = distinct_points(sec, tol)
+        t_start = float(k[-1] * T)
+
+        def flow(x, t0, t1, mode=None, loop=loop):
+            return loop.flow(x, t_start + t0, t_start + t1, mode, rtol=rtol, atol=atol)
+
+        lyap = largest_lyapunov(flow, (seg.y_end, seg.mode_end), T, n_lyap, d0=d0, difference=state_difference)
+        verdict = classify(n_dist if n_dist <= 8 else 0, lyap.value, lyap.stderr)
+        out.append(Regime(angle_limit=float(bmax), section=sec, n_distinct=n_dist, lyapunov=lyap.value,
+                          lyapunov_stderr=lyap.stderr, verdict=verdict, n_crossings=seg.n_crossings,
+                          t_sliding=seg.t_sliding))
+    return out

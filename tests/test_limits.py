@@ -1,0 +1,101 @@
+import math
+
+import numpy as np
+import pytest
+
+from lib import limits as L, trajectories as T
+from lib.params import Body, Gains
+from lib.simulate import simulate
+
+S0 = np.array([1.0, 0.0, math.pi / 2, 0.0, 0.0, 0.0])
+
+
+def test_lyapunov_estimate_is_negative_for_damped_linear_system():
+    est = L.largest_lyapunov(L.damped_oscillator_flow(zeta=0.1), np.array([1.0, 0.0]), 1.0, 60)
+    assert est.value < 0
+    assert abs(est.value - (-0.1)) < 0.02
+
+
+def test_lyapunov_estimate_is_positive_for_baker_gollub_chaotic_pendulum():
+    flow = L.driven_pendulum_flow(q=2.0, g=1.5, omega_d=2 / 3, rtol=1e-9, atol=1e-9)
+    est = L.largest_lyapunov(flow, np.array([0.2, 0.0]), 3 * math.pi, 80, n_transient=10)
+    assert est.value > 3 * est.stderr and est.value > 0.05
+
+
+def test_lyapunov_estimate_is_negative_for_periodic_pendulum():
+    # Baker & Gollub's g = 0.9 (q = 2) is a stable periodic motion
+    flow = L.driven_pendulum_flow(q=2.0, g=0.9, omega_d=2 / 3, rtol=1e-9, atol=1e-9)
+    est = L.largest_lyapunov(flow, np.array([0.2, 0.0]), 3 * math.pi, 30, n_transient=10)
+    assert est.value < 0
+
+
+def test_poincare_section_of_periodic_case_has_one_point():
+    # the circle under a loose angle limit settles on the stable rotation equilibrium
+    loop = L.SwitchedLoop(Body(), Gains(), T.circle(), np.deg2rad(150))
+    sec = L.stroboscopic_section(loop, S0, 15, 5, rtol=1e-10, atol=1e-10)
+    assert L.distinct_points(sec, 1e-6) == 1
+    assert np.abs(sec[:, :4]).max() < 1e-6
+
+
+def test_distinct_points_counts_a_period_two_orbit():
+    pts = np.array([[0.0, 1.0], [1.0, 0.0]] * 5) + 1e-9
+    assert L.distinct_points(pts, 1e-6) == 2
+
+
+@pytest.mark.parametrize("switching", ["stepsize", "events"])
+def test_beta_never_exceeds_angle_limit(switching):
+    bmax = np.deg2rad(30)
+    res = simulate(Body(), Gains(), T.eight(), 24.0, angle_limit=bmax, switching=switching, rtol=1e-8, atol=1e-8)
+    assert np.all(np.abs(res.beta) <= bmax + 1e-12)
+
+
+def test_event_located_run_converges_as_tolerance_tightens():
+    loop = L.SwitchedLoop(Body(), Gains(), T.eight(), np.deg2rad(30))
+    ends = [loop.integrate(S0, 0.0, 16.0, rtol=tol, atol=tol) for tol in (1e-8, 1e-10, 1e-12)]
+    assert ends[-1].n_crossings > 0
+    d1 = np.abs(L.state_difference(ends[0].y_end, ends[2].y_end)).max()
+    d2 = np.abs(L.state_difference(ends[1].y_end, ends[2].y_end)).max()
+    assert d2 < 1e-6 and d2 < d1
+
+
+def test_event_located_and_stepsize_runs_agree_at_tight_tolerance():
+    ref, bmax = T.eight(), np.deg2rad(60)
+    a = simulate(Body(), Gains(), ref, 12.0, angle_limit=bmax, switching="events", rtol=1e-11, atol=1e-11)
+    b = simulate(Body(), Gains(), ref, 12.0, angle_limit=bmax, rtol=1e-11, atol=1e-11)
+    assert np.abs(a.z - b.z).max() < 1e-5
+
+
+def test_sliding_motion_stays_on_switching_surface():
+    loop = L.SwitchedLoop(Body(), Gains(), T.eight(), np.deg2rad(20))
+    seg = loop.integrate(S0, 0.0, 200.0, t_eval=np.linspace(0, 200, 40001), rtol=1e-10, atol=1e-10)
+    assert seg.n_slides > 0
+    sl = seg.mode == 0
+    assert sl.any()
+    lat = np.array([loop.lateral(t, y) for t, y in zip(seg.t[sl], seg.y[sl])])
+    assert np.abs(lat).max() < 1e-6
+    # while sliding both one-sided fields push towards the surface
+    rates = np.array([loop.one_sided_rates(t, y) for t, y in zip(seg.t[sl], seg.y[sl])])
+    assert np.all(rates[:, 0] <= 1e-6) and np.all(rates[:, 1] >= -1e-6)
+
+
+def test_classify_reads_sections_and_exponents():
+    assert L.classify(1, -0.1, 0.01) == "periodic-1"
+    assert L.classify(2, -0.1, 0.01) == "periodic-2"
+    assert L.classify(0, 0.3, 0.05) == "chaotic"
+    assert L.classify(0, 0.002, 0.002) == "quasi-periodic"
+
+
+@pytest.mark.parametrize("kw,msg", [
+    ({"angle_limit": 0.0}, "angle_limit"), ({"angle_limit": math.pi}, "angle_limit"),
+    ({"angle_limit": 0.5, "force_limit": -1.0}, "force_limit"),
+])
+def test_switched_loop_rejects_bad_limits(kw, msg):
+    with pytest.raises(ValueError, match=msg):
+        L.SwitchedLoop(Body(), Gains(), T.eight(), **kw)
+
+
+def test_simulate_events_needs_an_angle_limit():
+    with pytest.raises(ValueError, match="angle_limit below pi"):
+        simulate(Body(), Gains(), T.eight(), 1.0, switching="events")
+    with pytest.raises(ValueError, match="switching"):
+        simulate(Body(), Gains(), T.eight(), 1.0, switching="magic")

@@ -1,0 +1,95 @@
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from lib import control, model, tracking as TR, trajectories as T
+from lib.params import Body, Gains
+
+
+def _phi_accel_on_circle(body, gains, R, theta, p):
+    """phi'' when the position is on the circle exactly and phi = phi_d + p, phi' = theta:
+    straight from the model (23), (25)-(26), (2)-(4), not from a derived formula."""
+    ref = T.circle(R, theta)
+    t = 0.3
+    z = ref.z(t) + np.array([0.0, 0.0, p])
+    dz = ref.dz(t)
+    tau = control.computed_torque(body, gains, ref, t, z, dz)
+    F, beta = control.allocate(tau, z[2])
+    return model.config_accel(body, z, dz, F, beta)[2]
+
+
+def _stable_root_from_model(body, gains, R, theta):
+    g = lambda p: _phi_accel_on_circle(body, gains, R, theta, p)
+    grid = np.linspace(-math.pi, math.pi, 361)
+    v = np.array([g(p) for p in grid])
+    roots = [brentq(g, grid[i], grid[i + 1], xtol=1e-14) for i in np.flatnonzero(np.diff(np.sign(v)))]
+    return [r for r in roots if g(r + 1e-6) < g(r - 1e-6)]
+
+
+def test_steady_circle_rotation_error_equals_analytic_equilibrium():
+    body, gains = Body(), Gains()
+    (p_model,) = _stable_root_from_model(body, gains, 2.0, math.pi / 4)
+    res = TR.run(body, gains, "circle", 2.0, math.pi / 4, 10)
+    assert abs(TR.rotation_error_continuous(res)[-1] - p_model) < 1e-6
+    assert abs(TR.circle_rotation_equilibrium(body, 2.0, math.pi / 4) - p_model) < 1e-10
+
+
+@pytest.mark.parametrize("R,theta", [(1.0, 0.5), (3.0, 1.2), (0.5, -0.8)])
+def test_circle_equilibrium_formula_matches_model_root(R, theta):
+    body, gains = Body(), Gains()
+    roots = _stable_root_from_model(body, gains, R, theta)
+    assert len(roots) == 1
+    assert abs(TR.circle_rotation_equilibrium(body, R, theta) - roots[0]) < 1e-9
+
+
+def test_no_circle_equilibrium_below_critical_radius():
+    with pytest.raises(ValueError, match="no rotation equilibrium"):
+        TR.circle_rotation_equilibrium(Body(), 0.01, math.pi / 4)
+
+
+def test_eight_position_errors_follow_eq24_and_rotation_stays_bounded():
+    body, gains = Body(), Gains()
+    res = TR.run(body, gains, "eight", 2.0, math.pi / 4, 6, samples_per_period=50)
+    assert TR.position_deviation_from_eq24(body, gains, res) < 1e-8
+    s = TR.steady_summary(res, 1.0)
+    assert s["pos_err_max"] < 1e-6 and s["p_range"] < 2 * math.pi
+
+
+def test_saturated_force_never_exceeds_cap():
+    body, gains = Body(), Gains()
+    res = TR.run(body, gains, "eight", 2.0, math.pi / 4, 4, samples_per_period=100, force_limit=4.0,
+                 rtol=1e-8, atol=1e-8)
+    assert res.F.max() <= 4.0 + 1e-12
+    iv = TR.saturated_intervals(res.t, res.F, 4.0)
+    assert iv and all(b >= a for a, b in iv)
+    inside = np.zeros(res.t.size, bool)
+    for a, b in iv:
+        inside |= (res.t >= a) & (res.t <= b)
+    np.testing.assert_array_equal(inside, res.F >= 4.0 * (1 - 1e-9))
+
+
+def test_saturated_intervals_on_a_known_signal():
+    t = np.linspace(0, 10, 1001)
+    F = np.minimum(2 + 2 * np.sin(t), 3.0)
+    iv = TR.saturated_intervals(t, F, 3.0)
+    # sin t >= 1/2 on [pi/6, 5pi/6] and [pi/6 + 2pi, 5pi/6 + 2pi]
+    exact = [(math.pi / 6, 5 * math.pi / 6), (math.pi / 6 + 2 * math.pi, 5 * math.pi / 6 + 2 * math.pi)]
+    assert len(iv) == 2
+    np.testing.assert_allclose(np.array(iv), np.array(exact), atol=0.011)
+
+
+def test_steady_position_error_grows_as_force_cap_falls():
+    df = TR.force_cap_sweep(Body(), Gains(), T.eight(), [3.0, 4.0, 5.0, 7.0], n_periods=5)
+    err = df["pos_err_max"].to_numpy()
+    assert np.all(np.diff(err) < 0)
+    assert err[-1] < 1e-6  # 7 N exceeds the largest force the eight needs: no error left
+
+
+def test_bad_input_is_rejected():
+    with pytest.raises(ValueError, match="t and F"):
+        TR.saturated_intervals([0, 1], [1.0], 1.0)
+    res = TR.run(Body(), Gains(), "circle", 2.0, 1.0, 0.5, samples_per_period=20)
+    with pytest.raises(ValueError, match="n_periods"):
+        TR.steady_mask(res, 0.0)
