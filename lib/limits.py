@@ -42,7 +42,7 @@ from .trajectories import Circle, Eight, Reference
 __all__ = [
     "SwitchedLoop", "Segments", "reference_kinematics", "error_state", "stroboscopic_section",
     "largest_lyapunov", "LyapunovEstimate", "distinct_points", "classify", "Regime", "sweep_angle_limit",
-    "damped_oscillator_flow", "driven_pendulum_flow", "state_difference",
+    "section_sweep", "section_period", "damped_oscillator_flow", "driven_pendulum_flow", "state_difference",
 ]
 
 TWO_PI = 2.0 * math.pi
@@ -398,6 +398,26 @@ def distinct_points(points, tol: float) -> int:
     return len(reps)
 
 
+def section_period(points, tol: float, max_period: int = 8) -> tuple[int, bool]:
+    """Smallest period k <= ``max_period`` of a stroboscopic sequence, and whether it is
+    still converging: (k, False) if the last points repeat every k periods within
+    ``tol`` (max-norm); (k, True) if d_j = |P_(j+k) - P_j| shrinks strictly at every
+    step over the second half of the sequence (a periodic orbit approached slowly);
+    (0, False) if neither holds for any k."""
+    pts = np.atleast_2d(np.asarray(points, dtype=float))
+    n = pts.shape[0]
+    if n < 4:
+        raise ValueError("need at least 4 section points")
+    for k in range(1, min(max_period, n // 2) + 1):
+        d = np.max(np.abs(pts[k:] - pts[:-k]), axis=1)
+        tail = d[len(d) // 2:]
+        if np.all(tail[-k:] <= tol):
+            return k, False
+        if tail.size >= 4 and np.all(np.diff(tail) < 0):
+            return k, True
+    return 0, False
+
+
 @dataclass(frozen=True)
 class LyapunovEstimate:
     """Largest Lyapunov exponent (1/s) with its standard error over the renormalisation
@@ -487,13 +507,15 @@ def driven_pendulum_flow(q: float = 2.0, g: float = 1.5, omega_d: float = 2.0 / 
 
 @dataclass(frozen=True)
 class Regime:
-    """Long-run behaviour at one angle limit: the stroboscopic section, the number of
-    distinct section points (0 means "more than ``max_period``"), the largest
-    Lyapunov exponent (1/s) with its standard error, and the verdict."""
+    """Long-run behaviour at one angle limit: the stroboscopic section, its period
+    (:func:`section_period`; 0 means none up to 8) and whether it was still
+    converging, the largest Lyapunov exponent (1/s) with its standard error, the
+    verdict, and the crossings of and time sliding on the switching surface."""
 
     angle_limit: float
     section: np.ndarray
-    n_distinct: int
+    period: int
+    converging: bool
     lyapunov: float
     lyapunov_stderr: float
     verdict: str
@@ -501,55 +523,91 @@ class Regime:
     t_sliding: float
 
 
-def classify(n_distinct: int, lyapunov: float, stderr: float, *, max_period: int = 8,
-             zero_band: float = 0.01) -> str:
-    """Verdict from a section and an exponent (1/s).
+def classify(period: int, lyapunov: float, stderr: float, *, zero_band: float = 0.01) -> str:
+    """Verdict from a section period (:func:`section_period`, 0 = none found) and the
+    largest Lyapunov exponent (1/s) with its standard error.
 
-    "periodic-k" when the section has k <= ``max_period`` distinct points (and the
-    exponent is not significantly positive); "chaotic" when the exponent exceeds
-    both ``zero_band`` and three standard errors; otherwise "quasi-periodic"
-    when it is within ``zero_band`` of zero, and "undecided" when the two tests disagree.
+    "chaotic" when the exponent exceeds both ``zero_band`` and three standard
+    errors; otherwise "periodic-k" when the section has period k; otherwise
+    "quasi-periodic" when the exponent is known to be within ``zero_band`` of
+    zero (|lambda| and its standard error both below ``zero_band``); otherwise
+    "undecided" (the estimate is too noisy to decide).
     """
-    significant = lyapunov > max(zero_band, 3 * stderr)
-    if 0 < n_distinct <= max_period and not significant:
-        return f"periodic-{n_distinct}"
-    if significant:
+    if lyapunov > max(zero_band, 3 * stderr):
         return "chaotic"
-    if abs(lyapunov) <= zero_band + 3 * stderr:
+    if period > 0:
+        return f"periodic-{period}"
+    if abs(lyapunov) < zero_band and stderr < zero_band:
         return "quasi-periodic"
     return "undecided"
 
 
+def _map(fn, items, workers: int):
+    if workers <= 1 or len(items) <= 1:
+        return [fn(x) for x in items]
+    from concurrent.futures import ProcessPoolExecutor
+
+    with ProcessPoolExecutor(max_workers=workers) as ex:
+        return list(ex.map(fn, items))
+
+
+def _section_one(args):
+    body, gains, ref, bmax, force_limit, n_transient, n_points, rtol, atol, s0 = args
+    loop = SwitchedLoop(body, gains, ref, bmax, force_limit)
+    return stroboscopic_section(loop, s0, n_transient, n_points, rtol=rtol, atol=atol)
+
+
+def section_sweep(body: Body, gains: Gains, ref: Reference, angle_limits, *, force_limit=None,
+                  n_transient: int = 20, n_points: int = 24, rtol: float = 1e-8, atol: float = 1e-8,
+                  z0=None, dz0=None, workers: int = 1) -> list[np.ndarray]:
+    """Bifurcation data: the stroboscopic section (:func:`stroboscopic_section`,
+    ``n_points`` error states after ``n_transient`` periods) for each angle limit (rad),
+    from the paper's initial state unless ``z0``/``dz0`` are given; ``workers``
+    processes share the sweep."""
+    from .params import PAPER_DZ0, PAPER_Z0
+
+    s0 = np.concatenate([np.asarray(PAPER_Z0 if z0 is None else z0, dtype=float),
+                         np.asarray(PAPER_DZ0 if dz0 is None else dz0, dtype=float)])
+    items = [(body, gains, ref, float(b), force_limit, n_transient, n_points, rtol, atol, s0)
+             for b in np.atleast_1d(np.asarray(angle_limits, dtype=float))]
+    return _map(_section_one, items, workers)
+
+
 def sweep_angle_limit(body: Body, gains: Gains, ref: Reference, angle_limits, *, force_limit=None,
                       n_transient: int = 30, n_points: int = 40, n_lyap: int = 40, tol: float = 1e-4,
-                      rtol: float = 1e-10, atol: float = 1e-10, d0: float = 1e-5, z0=None, dz0=None) -> list[Regime]:
+                      rtol: float = 1e-10, atol: float = 1e-10, d0: float = 1e-5, z0=None, dz0=None,
+                      workers: int = 1) -> list[Regime]:
     """Classify the long-run regime for each angle limit (rad).
 
     For each limit: ``n_transient`` periods are discarded, ``n_points`` section
-    points recorded (distinct up to ``tol`` in the max-norm of the error state),
+    points recorded (their period found by :func:`section_period` with ``tol``),
     and the largest Lyapunov exponent estimated over ``n_lyap`` periods starting
     from the end of the section.
     """
     from .params import PAPER_DZ0, PAPER_Z0
 
-    z0 = np.asarray(PAPER_Z0 if z0 is None else z0, dtype=float)
-    dz0 = np.asarray(PAPER_DZ0 if dz0 is None else dz0, dtype=float)
-    out = []
-    for bmax in np.atleast_1d(np.asarray(angle_limits, dtype=float)):
-        loop = SwitchedLoop(body, gains, ref, float(bmax), force_limit)
-        T = loop.period
-        k = np.arange(n_transient, n_transient + n_points)
-        seg = loop.integrate(np.concatenate([z0, dz0]), 0.0, float(k[-1] * T), t_eval=k * T, rtol=rtol, atol=atol)
-        sec = error_state(ref, seg.t, seg.y)
-        n_dist = distinct_points(sec, tol)
-        t_start = float(k[-1] * T)
+    s0 = np.concatenate([np.asarray(PAPER_Z0 if z0 is None else z0, dtype=float),
+                         np.asarray(PAPER_DZ0 if dz0 is None else dz0, dtype=float)])
+    items = [(body, gains, ref, float(b), force_limit, n_transient, n_points, n_lyap, tol, rtol, atol, d0, s0)
+             for b in np.atleast_1d(np.asarray(angle_limits, dtype=float))]
+    return _map(_regime_one, items, workers)
 
-        def flow(x, t0, t1, mode=None, loop=loop):
-            return loop.flow(x, t_start + t0, t_start + t1, mode, rtol=rtol, atol=atol)
 
-        lyap = largest_lyapunov(flow, (seg.y_end, seg.mode_end), T, n_lyap, d0=d0, difference=state_difference)
-        verdict = classify(n_dist if n_dist <= 8 else 0, lyap.value, lyap.stderr)
-        out.append(Regime(angle_limit=float(bmax), section=sec, n_distinct=n_dist, lyapunov=lyap.value,
-                          lyapunov_stderr=lyap.stderr, verdict=verdict, n_crossings=seg.n_crossings,
-                          t_sliding=seg.t_sliding))
-    return out
+def _regime_one(args) -> Regime:
+    body, gains, ref, bmax, force_limit, n_transient, n_points, n_lyap, tol, rtol, atol, d0, s0 = args
+    loop = SwitchedLoop(body, gains, ref, bmax, force_limit)
+    T = loop.period
+    k = np.arange(n_transient, n_transient + n_points)
+    seg = loop.integrate(s0, 0.0, float(k[-1] * T), t_eval=k * T, rtol=rtol, atol=atol)
+    sec = error_state(ref, seg.t, seg.y)
+    period, converging = section_period(sec, tol)
+    t_start = float(k[-1] * T)
+
+    def flow(x, t0, t1, mode=None):
+        return loop.flow(x, t_start + t0, t_start + t1, mode, rtol=rtol, atol=atol)
+
+    lyap = largest_lyapunov(flow, (seg.y_end, seg.mode_end), T, n_lyap, d0=d0, difference=state_difference)
+    verdict = classify(period, lyap.value, lyap.stderr)
+    return Regime(angle_limit=bmax, section=sec, period=period, converging=converging, lyapunov=lyap.value,
+                  lyapunov_stderr=lyap.stderr, verdict=verdict, n_crossings=seg.n_crossings,
+                  t_sliding=seg.t_sliding)

@@ -56,3 +56,69 @@ def draw_body(x: float, y: float, phi: float, body: Body, F: float | None = None
                                      mutation_scale=10, color="C3", lw=1.5))
     ax.set_aspect("equal")
     return fig
+
+
+# ---------------------------------------------------------------- tracking (Chapters 3-4)
+
+def plot_path(res, body: Body, *, ax=None, n_bodies: int = 10, force_scale: float = 0.12, t_from: float = 0.0,
+              scale: float = 1.0, reference: bool = True):
+    """Fig. 2a/3a: the reference path (dashed), the path of C, and the body with its
+    force vector at ``n_bodies`` regular instants from ``t_from`` (s). Returns the figure."""
+    fig, ax = new_axes(ax)
+    if reference:
+        ax.plot(res.z_d[:, 0], res.z_d[:, 1], "k--", lw=1, label="reference")
+    ax.plot(res.z[:, 0], res.z[:, 1], "C0", lw=1.2, label="body (C)")
+    idx = np.linspace(np.searchsorted(res.t, t_from), res.t.size - 1, n_bodies).astype(int)
+    for i in idx:
+        draw_body(res.z[i, 0], res.z[i, 1], res.z[i, 2], body, F=res.F[i], beta=res.beta[i], ax=ax,
+                  force_scale=force_scale, scale=scale)
+    ax.set(xlabel="x (m)", ylabel="y (m)", aspect="equal")
+    ax.legend(loc="upper right", fontsize=8)
+    return fig
+
+
+def plot_errors(res, *, ax=None, p=None):
+    """Fig. 2b/3b: position errors e_x, e_y (m) and the rotation error p = phi - phi_d (rad)
+    against time. ``p`` overrides the rotation error (e.g. a continuous version)."""
+    fig, ax = new_axes(ax)
+    e = res.error
+    ax.plot(res.t, e[:, 0], "C0", label=r"$e_x$ (m)")
+    ax.plot(res.t, e[:, 1], "C1", label=r"$e_y$ (m)")
+    ax.plot(res.t, res.rotation_error() if p is None else p, "C2", label=r"$p=\varphi-\varphi_d$ (rad)")
+    ax.axhline(0, color="k", lw=0.5)
+    ax.set(xlabel="t (s)", ylabel="error")
+    ax.legend(fontsize=8)
+    return fig
+
+
+def plot_force(res, cap: float | None = None, *, ax=None, intervals=None):
+    """Force magnitude F (N) against time, with the cap and the saturated intervals shaded."""
+    fig, ax = new_axes(ax)
+    ax.plot(res.t, res.F, "C3", lw=1)
+    if cap is not None:
+        ax.axhline(cap, color="k", ls=":", lw=1, label=f"cap {cap:g} N")
+        for a, b in intervals or []:
+            ax.axvspan(a, b, color="C3", alpha=0.15, lw=0)
+        ax.legend(fontsize=8)
+    ax.set(xlabel="t (s)", ylabel="F (N)")
+    return fig
+
+
+def plot_bifurcation(angle_limits, sections, column: int = 4, *, ax=None, label: str = r"$p$ at $t=kT$ (rad)"):
+    """Bifurcation diagram: for each angle limit (rad, plotted in degrees), the chosen
+    column of its stroboscopic section (default the rotation error p)."""
+    fig, ax = new_axes(ax)
+    for b, sec in zip(angle_limits, sections):
+        ax.plot(np.full(len(sec), np.rad2deg(b)), sec[:, column], "k.", ms=2)
+    ax.set(xlabel=r"angle limit $\beta_{max}$ (deg)", ylabel=label)
+    return fig
+
+
+def plot_section(section, i: int = 0, j: int = 4, *, ax=None, color: str = "k", label=None):
+    """Stroboscopic (Poincaré) section: column ``j`` against column ``i`` of an error-state
+    array [e_x, e_y, de_x, de_y, p, dp]."""
+    names = [r"$e_x$ (m)", r"$e_y$ (m)", r"$\dot e_x$ (m/s)", r"$\dot e_y$ (m/s)", r"$p$ (rad)", r"$\dot p$ (rad/s)"]
+    fig, ax = new_axes(ax)
+    ax.plot(section[:, i], section[:, j], ".", color=color, ms=3, label=label)
+    ax.set(xlabel=names[i], ylabel=names[j])
+    return fig

@@ -40,6 +40,15 @@ def test_poincare_section_of_periodic_case_has_one_point():
 def test_distinct_points_counts_a_period_two_orbit():
     pts = np.array([[0.0, 1.0], [1.0, 0.0]] * 5) + 1e-9
     assert L.distinct_points(pts, 1e-6) == 2
+    assert L.section_period(pts, 1e-6) == (2, False)
+
+
+def test_section_period_sees_slow_convergence_and_not_a_rotation():
+    conv = np.array([[0.5 + 0.9**k, 1.0] for k in range(20)])
+    assert L.section_period(conv, 1e-8) == (1, True)
+    k = np.arange(40)
+    rot = np.column_stack([np.cos(k * np.sqrt(2)), np.sin(k * np.sqrt(2))])  # quasi-periodic section
+    assert L.section_period(rot, 1e-6) == (0, False)
 
 
 @pytest.mark.parametrize("switching", ["stepsize", "events"])
@@ -83,6 +92,7 @@ def test_classify_reads_sections_and_exponents():
     assert L.classify(2, -0.1, 0.01) == "periodic-2"
     assert L.classify(0, 0.3, 0.05) == "chaotic"
     assert L.classify(0, 0.002, 0.002) == "quasi-periodic"
+    assert L.classify(0, 0.1, 0.06) == "undecided"
 
 
 @pytest.mark.parametrize("kw,msg", [
