@@ -7,13 +7,14 @@ from __future__ import annotations
 
 import base64
 import html
+import re
 
 import numpy as np
 
 from .params import Body
 from .plotting import body_outline
 
-__all__ = ["animate", "csv_link"]
+__all__ = ["animate", "csv_link", "offline_controls"]
 
 
 def animate(res, body: Body, *, n_frames: int = 60, t_from: float = 0.0, dpi: int = 60,
@@ -59,6 +60,25 @@ def animate(res, body: Body, *, n_frames: int = 60, t_from: float = 0.0, dpi: in
     anim = FuncAnimation(fig, frame, frames=len(idx), interval=1000 / fps, blit=True)
     out = anim.to_jshtml(fps=fps, default_mode="loop")
     plt.close(fig)
+    return offline_controls(out)
+
+
+#: matplotlib's player buttons use Font Awesome 4 icons from a CDN; offline, use plain symbols
+_ICONS = {
+    "fa fa-minus": "&#8722;", "fa fa-fast-backward": "&#9198;", "fa fa-step-backward": "&#9664;&#10074;",
+    "fa fa-play fa-flip-horizontal": "&#9664;", "fa fa-pause": "&#10074;&#10074;", "fa fa-play": "&#9654;",
+    "fa fa-step-forward": "&#10074;&#9654;", "fa fa-fast-forward": "&#9197;", "fa fa-plus": "+",
+}
+
+
+def offline_controls(jshtml: str) -> str:
+    """Make matplotlib's ``to_jshtml`` output self-contained: drop the stylesheet link
+    to the Font Awesome CDN and replace each icon by a Unicode symbol."""
+    out = re.sub(r"<link[^>]*font-awesome[^>]*>", "", jshtml, flags=re.S)
+    for cls, sym in _ICONS.items():
+        out = out.replace(f'<i class="{cls}"></i>', f"<span>{sym}</span>")
+    if "font-awesome" in out or 'class="fa ' in out:
+        raise RuntimeError("animation HTML still refers to Font Awesome; matplotlib's template changed")
     return out
 
 
