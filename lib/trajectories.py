@@ -12,7 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Reference", "Circle", "Eight", "circle", "eight", "make", "NAMES"]
+__all__ = ["Reference", "Circle", "Eight", "circle", "eight", "make", "NAMES", "circle_kinematics",
+           "eight_kinematics", "KINEMATICS"]
 
 
 def _check_shape(R: float, theta: float) -> tuple[float, float]:
@@ -61,18 +62,13 @@ class Circle(Reference):
         return 2 * math.pi / abs(self.theta)
 
     def z(self, t) -> np.ndarray:
-        s = self.theta * np.asarray(t, dtype=float)
-        return np.stack([self.R * np.cos(s), self.R * np.sin(s), s + math.pi / 2], axis=-1)
+        return circle_kinematics(self.R, self.theta, t)[0]
 
     def dz(self, t) -> np.ndarray:
-        s = self.theta * np.asarray(t, dtype=float)
-        R, th = self.R, self.theta
-        return np.stack([-R * th * np.sin(s), R * th * np.cos(s), np.full_like(s, th)], axis=-1)
+        return circle_kinematics(self.R, self.theta, t)[1]
 
     def ddz(self, t) -> np.ndarray:
-        s = self.theta * np.asarray(t, dtype=float)
-        R, th = self.R, self.theta
-        return np.stack([-R * th**2 * np.cos(s), -R * th**2 * np.sin(s), np.zeros_like(s)], axis=-1)
+        return circle_kinematics(self.R, self.theta, t)[2]
 
 
 @dataclass(frozen=True)
@@ -105,35 +101,54 @@ class Eight(Reference):
 
     def heading(self, t) -> np.ndarray:
         """Continuous tangent angle phi_d(t) (rad)."""
-        s = self.theta * np.asarray(t, dtype=float)
-        sign = np.sign(self.theta)
-        # for theta < 0 the velocity reverses, the tangent turns by pi
-        base = np.pi + np.arctan2(-np.cos(s), -np.cos(2 * s))
-        return base if sign > 0 else base - np.pi
+        return eight_kinematics(self.R, self.theta, t)[0][..., 2]
 
     def z(self, t) -> np.ndarray:
-        s = self.theta * np.asarray(t, dtype=float)
-        return np.stack([0.5 * self.R * np.sin(2 * s), self.R * np.sin(s), self.heading(t)], axis=-1)
+        return eight_kinematics(self.R, self.theta, t)[0]
 
     def dz(self, t) -> np.ndarray:
-        s = self.theta * np.asarray(t, dtype=float)
-        R, th = self.R, self.theta
-        num = 2 * np.cos(s) * np.sin(2 * s) - np.cos(2 * s) * np.sin(s)
-        den = np.cos(2 * s) ** 2 + np.cos(s) ** 2
-        return np.stack([R * th * np.cos(2 * s), R * th * np.cos(s), th * num / den], axis=-1)
+        return eight_kinematics(self.R, self.theta, t)[1]
 
     def ddz(self, t) -> np.ndarray:
-        s = self.theta * np.asarray(t, dtype=float)
-        R, th = self.R, self.theta
-        num = 2 * np.cos(s) * np.sin(2 * s) - np.cos(2 * s) * np.sin(s)
-        den = np.cos(2 * s) ** 2 + np.cos(s) ** 2
-        dnum = 3 * np.cos(s) * np.cos(2 * s)
-        dden = -2 * np.sin(4 * s) - np.sin(2 * s)
-        return np.stack([
-            -2 * R * th**2 * np.sin(2 * s),
-            -R * th**2 * np.sin(s),
-            th**2 * (dnum * den - num * dden) / den**2,
-        ], axis=-1)
+        return eight_kinematics(self.R, self.theta, t)[2]
+
+
+def circle_kinematics(R, theta, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(z_d, dz_d, ddz_d) of the circle (27), broadcast over arrays R (m), theta (rad/s), t (s).
+
+    Unvalidated array form behind :class:`Circle`, for batch computations;
+    each array has shape broadcast(R, theta, t) + (3,).
+    """
+    R, th, t = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (R, theta, t)))
+    s = th * t
+    c, sn = np.cos(s), np.sin(s)
+    z = np.stack([R * c, R * sn, s + np.pi / 2], axis=-1)
+    dz = np.stack([-R * th * sn, R * th * c, th], axis=-1)
+    ddz = np.stack([-R * th**2 * c, -R * th**2 * sn, np.zeros_like(s)], axis=-1)
+    return z, dz, ddz
+
+
+def eight_kinematics(R, theta, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(z_d, dz_d, ddz_d) of the eight (28) with the continuous heading, broadcast
+    over arrays R (m), theta (rad/s), t (s); the array form behind :class:`Eight`.
+
+    phi_d = pi + atan2(-cos s, -cos 2s) (minus pi for theta < 0), s = theta t;
+    phi_d' = theta N / D and phi_d'' = theta^2 (N' D - N D') / D^2 with
+    N = 2 cos s sin 2s - cos 2s sin s, D = cos^2 2s + cos^2 s,
+    N' = 3 cos s cos 2s, D' = -2 sin 4s - sin 2s.
+    """
+    R, th, t = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (R, theta, t)))
+    s = th * t
+    c1, s1, c2, s2 = np.cos(s), np.sin(s), np.cos(2 * s), np.sin(2 * s)
+    heading = np.pi + np.arctan2(-c1, -c2) - np.where(th < 0, np.pi, 0.0)
+    num = 2 * c1 * s2 - c2 * s1
+    den = c2**2 + c1**2
+    dnum = 3 * c1 * c2
+    dden = -2 * np.sin(4 * s) - s2
+    z = np.stack([0.5 * R * s2, R * s1, heading], axis=-1)
+    dz = np.stack([R * th * c2, R * th * c1, th * num / den], axis=-1)
+    ddz = np.stack([-2 * R * th**2 * s2, -R * th**2 * s1, th**2 * (dnum * den - num * dden) / den**2], axis=-1)
+    return z, dz, ddz
 
 
 def circle(R: float = 2.0, theta: float = math.pi / 4) -> Circle:
@@ -157,3 +172,7 @@ def make(name: str, R: float, theta: float) -> Reference:
     except (KeyError, TypeError):
         raise ValueError(f"unknown trajectory {name!r}; known: {sorted(NAMES)}") from None
     return factory(R, theta)
+
+
+#: the array forms, by name, for batch computations over many (R, theta)
+KINEMATICS = {"circle": circle_kinematics, "eight": eight_kinematics}

@@ -68,3 +68,15 @@ def test_unknown_trajectory_name_raises():
     with pytest.raises(ValueError, match="unknown trajectory 'square'"):
         T.make("square", 1.0, 1.0)
     assert isinstance(T.make("eight", 1.0, 1.0), T.Eight)
+
+
+def test_batch_kinematics_equal_the_reference_objects_point_by_point():
+    R = np.array([0.5, 2.0, 3.5])
+    theta = np.array([0.1, -0.7, 1.4])
+    t = np.linspace(0, 20, 7)[:, None]
+    for name, kin in T.KINEMATICS.items():
+        batch = kin(R, theta, t)
+        for j in range(3):
+            ref = T.make(name, R[j], theta[j])
+            for k, method in enumerate((ref.z, ref.dz, ref.ddz)):
+                np.testing.assert_array_equal(batch[k][:, j], method(t[:, 0]))
