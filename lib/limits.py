@@ -402,7 +402,8 @@ def section_period(points, tol: float, max_period: int = 8) -> tuple[int, bool]:
     """Smallest period k <= ``max_period`` of a stroboscopic sequence, and whether it is
     still converging: (k, False) if the last points repeat every k periods within
     ``tol`` (max-norm); (k, True) if d_j = |P_(j+k) - P_j| shrinks strictly at every
-    step over the second half of the sequence (a periodic orbit approached slowly);
+    step over the second half of the sequence, at least 8 steps (a periodic orbit
+    approached slowly; fewer steps could shrink by chance);
     (0, False) if neither holds for any k."""
     pts = np.atleast_2d(np.asarray(points, dtype=float))
     n = pts.shape[0]
@@ -413,7 +414,7 @@ def section_period(points, tol: float, max_period: int = 8) -> tuple[int, bool]:
         tail = d[len(d) // 2:]
         if np.all(tail[-k:] <= tol):
             return k, False
-        if tail.size >= 4 and np.all(np.diff(tail) < 0):
+        if tail.size >= 8 and np.all(np.diff(tail) < 0):
             return k, True
     return 0, False
 
