@@ -61,14 +61,16 @@ def draw_body(x: float, y: float, phi: float, body: Body, F: float | None = None
 # ---------------------------------------------------------------- tracking (Chapters 3-4)
 
 def plot_path(res, body: Body, *, ax=None, n_bodies: int = 10, force_scale: float = 0.12, t_from: float = 0.0,
-              scale: float = 1.0, reference: bool = True):
+              scale: float = 1.0, reference: bool = True, endpoint: bool = True):
     """Fig. 2a/3a: the reference path (dashed), the path of C, and the body with its
-    force vector at ``n_bodies`` regular instants from ``t_from`` (s). Returns the figure."""
+    force vector at ``n_bodies`` regular instants from ``t_from`` (s) to the end
+    (excluded when ``endpoint`` is False, e.g. over one whole period, where the
+    first and last instants coincide). Returns the figure."""
     fig, ax = new_axes(ax)
     if reference:
         ax.plot(res.z_d[:, 0], res.z_d[:, 1], "k--", lw=1, label="reference")
     ax.plot(res.z[:, 0], res.z[:, 1], "C0", lw=1.2, label="body (C)")
-    idx = np.linspace(np.searchsorted(res.t, t_from), res.t.size - 1, n_bodies).astype(int)
+    idx = np.linspace(np.searchsorted(res.t, t_from), res.t.size - 1, n_bodies, endpoint=endpoint).astype(int)
     for i in idx:
         draw_body(res.z[i, 0], res.z[i, 1], res.z[i, 2], body, F=res.F[i], beta=res.beta[i], ax=ax,
                   force_scale=force_scale, scale=scale)

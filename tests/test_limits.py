@@ -109,3 +109,11 @@ def test_simulate_events_needs_an_angle_limit():
         simulate(Body(), Gains(), T.eight(), 1.0, switching="events")
     with pytest.raises(ValueError, match="switching"):
         simulate(Body(), Gains(), T.eight(), 1.0, switching="magic")
+
+
+def test_angle_limit_60_degrees_gives_a_stable_period_two_motion():
+    # the period-2 example of Chapter 4: two section points and a negative exponent
+    (reg,) = L.sweep_angle_limit(Body(), Gains(), T.eight(), [np.deg2rad(60)], n_transient=15, n_points=10,
+                                 n_lyap=6, rtol=1e-9, atol=1e-9)
+    assert reg.period == 2 and not reg.converging
+    assert reg.lyapunov < 0 and reg.verdict == "periodic-2"
