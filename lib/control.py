@@ -109,7 +109,8 @@ def allocate_least_squares(tau, phi, body: Body, weights=(1.0, 1.0, 0.0),
     with w_phi = 0 it is exactly the position-only law (25)-(26).
 
     ``weights`` = (w_x, w_y, w_phi) >= 0, not all zero (units: w_phi weighs a
-    torque residual in (N m)^2 against force residuals in N^2). Limits are then
+    torque residual in (N m)^2 against force residuals in N^2); an array of
+    shape (..., 3) gives one weight triple per demand. Limits are then
     applied as in :func:`allocate` (cap on F, clip of beta): a projection of the
     unconstrained optimum, not the optimum under the limits.
 
@@ -119,15 +120,25 @@ def allocate_least_squares(tau, phi, body: Body, weights=(1.0, 1.0, 0.0),
     if tau.ndim == 0 or tau.shape[-1] != 3:
         raise ValueError(f"tau must have a last axis of length 3 (tau_x, tau_y, tau_phi), got shape {tau.shape}")
     w = np.asarray(weights, dtype=float)
-    if w.shape != (3,) or not np.all(np.isfinite(w)) or np.any(w < 0) or not np.any(w > 0):
+    if w.ndim == 0 or w.shape[-1] != 3 or not np.all(np.isfinite(w)) or np.any(w < 0) or not np.all(np.any(w > 0, -1)):
         raise ValueError(f"weights must be three finite non-negative numbers, not all zero, got {weights!r}")
     if not isinstance(body, Body):
         raise TypeError(f"body must be a lib.params.Body, got {type(body).__name__}")
     sw = np.sqrt(w)
-    A = sw[:, None] * input_matrix(phi, body)                  # (..., 3, 2)
+    A = sw[..., :, None] * input_matrix(phi, body)             # (..., 3, 2)
     A = np.broadcast_to(A, np.broadcast_shapes(A.shape, tau.shape[:-1] + (3, 2)))
-    rhs = (sw * tau)[..., None]                                # (..., 3, 1)
-    u = (np.linalg.pinv(A) @ rhs)[..., 0]                      # (..., 2)
+    b = sw * tau                                               # (..., 3)
+    # normal equations G u = r with G = A^T A (2 x 2), solved in closed form;
+    # where G is (nearly) singular, the pseudo-inverse gives the minimum-norm u
+    G = np.einsum("...ki,...kj->...ij", A, A)
+    r = np.einsum("...ki,...k->...i", A, b)
+    det = G[..., 0, 0] * G[..., 1, 1] - G[..., 0, 1] * G[..., 1, 0]
+    regular = det > 1e-12 * np.maximum(G[..., 0, 0] + G[..., 1, 1], 1e-300) ** 2
+    safe = np.where(regular, det, 1.0)
+    u = np.stack([(G[..., 1, 1] * r[..., 0] - G[..., 0, 1] * r[..., 1]) / safe,
+                  (G[..., 0, 0] * r[..., 1] - G[..., 1, 0] * r[..., 0]) / safe], axis=-1)
+    if not np.all(regular):
+        u = np.where(regular[..., None], u, (np.linalg.pinv(A) @ b[..., None])[..., 0])
     F = np.hypot(u[..., 0], u[..., 1])
     beta = np.where(F > 0, np.arctan2(u[..., 1], u[..., 0]), 0.0)
     return _limit(F, beta, force_limit, angle_limit)

@@ -86,3 +86,15 @@ def test_least_squares_rejects_bad_input(kw, exc, msg):
     args.update(kw)
     with pytest.raises(exc, match=msg):
         control.allocate_least_squares(**args)
+
+
+def test_per_demand_weights_equal_one_call_per_weight():
+    rng = np.random.default_rng(3)
+    tau, phi = rng.normal(size=(5, 3)), rng.normal(size=5)
+    W = np.c_[np.ones(5), np.ones(5), np.logspace(-2, 2, 5)]
+    F, beta = control.allocate_least_squares(tau, phi, Body(), W)
+    for i in range(5):
+        Fi, bi = control.allocate_least_squares(tau[i], phi[i], Body(), tuple(W[i]))
+        np.testing.assert_allclose([F[i], beta[i]], [Fi, bi], rtol=1e-12, atol=1e-14)
+    with pytest.raises(ValueError, match="not all zero"):
+        control.allocate_least_squares(tau, phi, Body(), np.c_[W[:, :2], W[:, 2]] * [1, 1, 1] * (np.arange(5) != 2)[:, None])

@@ -1,0 +1,160 @@
+"""Chapter 6: the closed loop with the weighted least-squares allocation, run for
+many parameter points at once.
+
+The position-only law (25)-(26) leaves the heading to itself; the weighted
+allocation :func:`lib.control.allocate_least_squares` trades position tracking
+for heading tracking through the weight w_phi. To map that trade-off over the
+(R, Theta) plane of Fig. 5 the closed loop (2)-(4), (23) is integrated for all
+points together with the classical fixed-step Runge-Kutta scheme of order 4,
+vectorised over points (each point may have its own R, Theta and weights). The
+step is chosen small against the fastest closed-loop time scale; the tests
+check the result against the adaptive, tight-tolerance :func:`lib.simulate.simulate`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from .control import allocate_least_squares
+from .model import config_accel
+from .params import Body, Gains
+from .trajectories import KINEMATICS
+
+__all__ = ["BatchResult", "closed_loop_batch", "steady_metrics"]
+
+
+@dataclass(frozen=True)
+class BatchResult:
+    """Samples of N closed-loop runs: ``t`` (n,), ``z``/``dz``/``z_d`` (n, N, 3), ``F`` (n, N) in N.
+
+    ``period`` (N,) is the reference period 2 pi / |Theta| of each point (s).
+    """
+
+    t: np.ndarray
+    z: np.ndarray
+    dz: np.ndarray
+    z_d: np.ndarray
+    F: np.ndarray
+    period: np.ndarray
+
+    @property
+    def rotation_error(self) -> np.ndarray:
+        """p = phi - phi_d (rad), shape (n, N)."""
+        return self.z[..., 2] - self.z_d[..., 2]
+
+    @property
+    def position_error(self) -> np.ndarray:
+        """Distance |(x, y) - (x_d, y_d)| (m), shape (n, N)."""
+        return np.hypot(*np.moveaxis(self.z[..., :2] - self.z_d[..., :2], -1, 0))
+
+
+def _points(R, Theta, weights):
+    R = np.atleast_1d(np.asarray(R, dtype=float))
+    Theta = np.atleast_1d(np.asarray(Theta, dtype=float))
+    w = np.asarray(weights, dtype=float)
+    if w.ndim == 1:
+        w = np.broadcast_to(w, (max(R.size, Theta.size), 3))
+    if R.ndim != 1 or Theta.ndim != 1 or w.ndim != 2 or w.shape[1] != 3:
+        raise ValueError("R and Theta must be 1-D arrays and weights (3,) or (N, 3)")
+    n = max(R.size, Theta.size, w.shape[0])
+    try:
+        R, Theta, w = np.broadcast_to(R, n), np.broadcast_to(Theta, n), np.broadcast_to(w, (n, 3))
+    except ValueError:
+        raise ValueError(f"R ({R.size}), Theta ({Theta.size}) and weights ({w.shape[0]}) must have equal "
+                         "lengths (or length 1)") from None
+    if n == 0:
+        raise ValueError("no parameter points given (empty arrays)")
+    if not (np.all(np.isfinite(R)) and np.all(R > 0)):
+        raise ValueError("every R must be a positive finite radius (m)")
+    if not (np.all(np.isfinite(Theta)) and np.all(Theta != 0)):
+        raise ValueError("every Theta must be finite and non-zero (rad/s)")
+    return R, Theta, w
+
+
+def closed_loop_batch(body: Body, gains: Gains, kind: str, R, Theta, weights=(1.0, 1.0, 0.0), *,
+                      t_end: float, dt: float = 0.01, record_dt: float = 0.05,
+                      z0=None, dz0=None) -> BatchResult:
+    """Integrate the closed loop with the weighted allocation for N points at once.
+
+    ``kind`` is ``"circle"`` or ``"eight"``; ``R`` (m), ``Theta`` (rad/s) and
+    ``weights`` (w_x, w_y, w_phi) are per point (arrays of length N, or one
+    value for all). The runs start on the reference (z = z_d(0), dz = dz_d(0))
+    unless ``z0``/``dz0`` (shape (3,) or (N, 3)) are given. Classical RK4 with
+    step ``dt`` (s) from 0 to ``t_end`` (s); samples every ``record_dt`` (s).
+    A run that becomes non-finite raises ``FloatingPointError`` naming the point.
+    """
+    if kind not in KINEMATICS:
+        raise ValueError(f"unknown trajectory {kind!r}; known: {sorted(KINEMATICS)}")
+    if not isinstance(body, Body) or not isinstance(gains, Gains):
+        raise TypeError("body must be a lib.params.Body and gains a lib.params.Gains")
+    for name, v in (("t_end", t_end), ("dt", dt), ("record_dt", record_dt)):
+        if not np.isfinite(v) or v <= 0:
+            raise ValueError(f"{name} must be a positive finite time (s), got {v!r}")
+    R, Theta, w = _points(R, Theta, weights)
+    kin = KINEMATICS[kind]
+    m = np.array([body.m, body.m, body.I])
+
+    def rhs(t, s):
+        z, dz = s[:, :3], s[:, 3:]
+        zd, dzd, ddzd = kin(R, Theta, t)
+        tau = m * ddzd + body.drag * dz + gains.kv * (dzd - dz) + gains.kp * (zd - z)
+        F, beta = allocate_least_squares(tau, z[:, 2], body, w)
+        return np.concatenate([dz, config_accel(body, z, dz, F, beta)], axis=1), F
+
+    zd0, dzd0, _ = kin(R, Theta, 0.0)
+    z0 = zd0 if z0 is None else np.broadcast_to(np.asarray(z0, dtype=float), zd0.shape)
+    dz0 = dzd0 if dz0 is None else np.broadcast_to(np.asarray(dz0, dtype=float), dzd0.shape)
+    s = np.concatenate([z0, dz0], axis=1)
+    n_steps = int(np.ceil(t_end / dt))
+    h = t_end / n_steps
+    every = max(1, int(round(record_dt / h)))
+    ts, states, forces = [], [], []
+    t = 0.0
+    for k in range(n_steps + 1):
+        k1, F = rhs(t, s)
+        if k % every == 0 or k == n_steps:
+            ts.append(t)
+            states.append(s.copy())
+            forces.append(F)
+        if k == n_steps:
+            break
+        k2, _ = rhs(t + h / 2, s + h / 2 * k1)
+        k3, _ = rhs(t + h / 2, s + h / 2 * k2)
+        k4, _ = rhs(t + h, s + h * k3)
+        s = s + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        t = (k + 1) * h
+        if not np.all(np.isfinite(s)):
+            bad = int(np.flatnonzero(~np.all(np.isfinite(s), axis=1))[0])
+            raise FloatingPointError(f"closed loop became non-finite at t = {t:.6g} s for point {bad} "
+                                     f"(R = {R[bad]:g} m, Theta = {Theta[bad]:g} rad/s, weights = {w[bad]})")
+    t = np.array(ts)
+    S = np.array(states)
+    return BatchResult(t=t, z=S[..., :3], dz=S[..., 3:], z_d=kin(R[None, :], Theta[None, :], t[:, None])[0],
+                       F=np.array(forces), period=2 * np.pi / np.abs(Theta))
+
+
+def steady_metrics(res: BatchResult, n_periods: float = 2.0) -> pd.DataFrame:
+    """Steady-state measures of each run over its last ``n_periods`` reference periods.
+
+    Columns: ``pos_rms`` and ``pos_max`` (m) of the position error; ``p_range``
+    (rad) max - min of the rotation error p; ``slip_per_period`` (turns) the
+    net change of p over the last period divided by 2 pi; ``heading_held``
+    True when that net change is below half a turn (the heading does not keep
+    slipping); ``F_max`` and ``F_rms`` (N).
+    """
+    out = []
+    p, e, F = res.rotation_error, res.position_error, res.F
+    for j, P in enumerate(res.period):
+        last = res.t >= res.t[-1] - n_periods * P
+        if res.t[-1] < (n_periods + 1) * P:
+            raise ValueError(f"run {j} is shorter than {n_periods + 1:g} reference periods; extend t_end")
+        one = res.t >= res.t[-1] - P
+        net = p[-1, j] - p[one, j][0]
+        out.append(dict(pos_rms=float(np.sqrt(np.mean(e[last, j] ** 2))), pos_max=float(e[last, j].max()),
+                        p_range=float(np.ptp(p[last, j])), slip_per_period=float(net / (2 * np.pi)),
+                        heading_held=bool(abs(net) < np.pi), F_max=float(F[last, j].max()),
+                        F_rms=float(np.sqrt(np.mean(F[last, j] ** 2)))))
+    return pd.DataFrame(out)
