@@ -20,7 +20,7 @@ from .simulate import SimulationResult, simulate
 from .trajectories import Reference, make
 
 __all__ = [
-    "run", "steady_mask", "rotation_error_continuous", "position_deviation_from_eq24",
+    "run", "steady_mask", "restrict", "rotation_error_continuous", "position_deviation_from_eq24",
     "steady_summary", "eight_sensitivity", "force_cap_sweep", "saturated_intervals",
     "circle_rotation_equilibrium", "ERRATA",
 ]
@@ -43,6 +43,18 @@ def steady_mask(res: SimulationResult, n_periods: float) -> np.ndarray:
     if n_periods <= 0:
         raise ValueError(f"n_periods must be positive, got {n_periods!r}")
     return res.t >= res.t[-1] - n_periods * res.ref.period - 1e-9
+
+
+def restrict(res: SimulationResult, mask) -> SimulationResult:
+    """The samples of ``res`` selected by the boolean ``mask`` (e.g. :func:`steady_mask`)."""
+    from dataclasses import replace
+
+    mask = np.asarray(mask, dtype=bool)
+    if mask.shape != res.t.shape or not mask.any():
+        raise ValueError("mask must be a boolean array like res.t selecting at least one sample")
+    fields = ("t", "z", "dz", "z_d", "dz_d", "F", "beta", "tau")
+    extra = {"mode": res.mode[mask]} if res.mode is not None else {}
+    return replace(res, **{k: getattr(res, k)[mask] for k in fields}, **extra)
 
 
 def rotation_error_continuous(res: SimulationResult) -> np.ndarray:

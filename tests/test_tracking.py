@@ -93,3 +93,13 @@ def test_bad_input_is_rejected():
     res = TR.run(Body(), Gains(), "circle", 2.0, 1.0, 0.5, samples_per_period=20)
     with pytest.raises(ValueError, match="n_periods"):
         TR.steady_mask(res, 0.0)
+    with pytest.raises(ValueError, match="mask"):
+        TR.restrict(res, np.zeros(res.t.size, bool))
+
+
+def test_restrict_keeps_the_selected_samples_consistent():
+    res = TR.run(Body(), Gains(), "eight", 2.0, 1.0, 2.0, samples_per_period=40)
+    sub = TR.restrict(res, TR.steady_mask(res, 1.0))
+    assert sub.t[0] >= res.t[-1] - res.ref.period - 1e-9
+    np.testing.assert_array_equal(sub.F, res.F[-sub.t.size:])
+    np.testing.assert_allclose(sub.error, sub.z_d - sub.z)
