@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .control import allocate_least_squares
+from .control import allocate_least_squares, wrap_angle
 from .model import config_accel
 from .params import Body, Gains
 from .trajectories import KINEMATICS
@@ -59,14 +59,14 @@ def _points(R, Theta, weights):
         w = np.broadcast_to(w, (max(R.size, Theta.size), 3))
     if R.ndim != 1 or Theta.ndim != 1 or w.ndim != 2 or w.shape[1] != 3:
         raise ValueError("R and Theta must be 1-D arrays and weights (3,) or (N, 3)")
+    if R.size == 0 or Theta.size == 0 or w.shape[0] == 0:
+        raise ValueError("no parameter points given (empty arrays)")
     n = max(R.size, Theta.size, w.shape[0])
     try:
         R, Theta, w = np.broadcast_to(R, n), np.broadcast_to(Theta, n), np.broadcast_to(w, (n, 3))
     except ValueError:
         raise ValueError(f"R ({R.size}), Theta ({Theta.size}) and weights ({w.shape[0]}) must have equal "
                          "lengths (or length 1)") from None
-    if n == 0:
-        raise ValueError("no parameter points given (empty arrays)")
     if not (np.all(np.isfinite(R)) and np.all(R > 0)):
         raise ValueError("every R must be a positive finite radius (m)")
     if not (np.all(np.isfinite(Theta)) and np.all(Theta != 0)):
@@ -140,10 +140,14 @@ def steady_metrics(res: BatchResult, n_periods: float = 2.0) -> pd.DataFrame:
     """Steady-state measures of each run over its last ``n_periods`` reference periods.
 
     Columns: ``pos_rms`` and ``pos_max`` (m) of the position error; ``p_range``
-    (rad) max - min of the rotation error p; ``slip_per_period`` (turns) the
+    (rad) max - min of the rotation error p; ``p_rms`` (rad) its RMS after
+    wrapping to (-pi, pi] (how far the heading is from the tangent); ``slip_per_period`` (turns) the
     net change of p over the last period divided by 2 pi; ``heading_held``
     True when that net change is below half a turn (the heading does not keep
-    slipping); ``F_max`` and ``F_rms`` (N).
+    slipping); ``pos_drift`` (m) the mean position error over the last period
+    minus that over the period before, and ``position_held`` True when it is
+    below 1 mm (the body does not drift away from the path); ``F_max`` and
+    ``F_rms`` (N).
     """
     out = []
     p, e, F = res.rotation_error, res.position_error, res.F
@@ -152,9 +156,13 @@ def steady_metrics(res: BatchResult, n_periods: float = 2.0) -> pd.DataFrame:
         if res.t[-1] < (n_periods + 1) * P:
             raise ValueError(f"run {j} is shorter than {n_periods + 1:g} reference periods; extend t_end")
         one = res.t >= res.t[-1] - P
+        before = (res.t >= res.t[-1] - 2 * P) & ~one
         net = p[-1, j] - p[one, j][0]
+        drift = float(e[one, j].mean() - e[before, j].mean())
+        p_wrapped = wrap_angle(p[last, j])
         out.append(dict(pos_rms=float(np.sqrt(np.mean(e[last, j] ** 2))), pos_max=float(e[last, j].max()),
-                        p_range=float(np.ptp(p[last, j])), slip_per_period=float(net / (2 * np.pi)),
-                        heading_held=bool(abs(net) < np.pi), F_max=float(F[last, j].max()),
+                        p_range=float(np.ptp(p[last, j])), p_rms=float(np.sqrt(np.mean(p_wrapped ** 2))), slip_per_period=float(net / (2 * np.pi)),
+                        heading_held=bool(abs(net) < np.pi), pos_drift=drift,
+                        position_held=bool(drift < 1e-3), F_max=float(F[last, j].max()),
                         F_rms=float(np.sqrt(np.mean(F[last, j] ** 2)))))
     return pd.DataFrame(out)

@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 from scipy.integrate import solve_ivp
 
-from .control import allocate, computed_torque
+from .control import allocate, allocate_least_squares, computed_torque
 from .model import config_accel
 from .params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from .trajectories import Reference
@@ -92,13 +92,33 @@ def _vector(name: str, value, default) -> np.ndarray:
     return arr
 
 
-def closed_loop_rhs(body: Body, gains: Gains, ref: Reference, force_limit=None, angle_limit=None):
+ALLOCATIONS = ("position", "least_squares")
+
+
+def allocator(body: Body, allocation: str = "position", weights=(1.0, 1.0, 0.0), force_limit=None, angle_limit=None):
+    """The allocation step tau, phi -> (F, beta) of the closed loop.
+
+    ``"position"``: the paper's position-only law (25)-(26), :func:`lib.control.allocate`;
+    ``"least_squares"``: the weighted law :func:`lib.control.allocate_least_squares`
+    with ``weights`` = (w_x, w_y, w_phi) (Chapter 6). Limits apply to both.
+    """
+    if allocation == "position":
+        return lambda tau, phi: allocate(tau, phi, force_limit, angle_limit)
+    if allocation == "least_squares":
+        allocate_least_squares(np.zeros(3), 0.0, body, weights, force_limit, angle_limit)  # validate once
+        return lambda tau, phi: allocate_least_squares(tau, phi, body, weights, force_limit, angle_limit)
+    raise ValueError(f"unknown allocation {allocation!r}; known: {ALLOCATIONS}")
+
+
+def closed_loop_rhs(body: Body, gains: Gains, ref: Reference, force_limit=None, angle_limit=None, *,
+                    allocation: str = "position", weights=(1.0, 1.0, 0.0)):
     """The closed-loop vector field s' = F(t, s) with s = [z, dz] (length 6)."""
+    alloc = allocator(body, allocation, weights, force_limit, angle_limit)
 
     def rhs(t: float, s: np.ndarray) -> np.ndarray:
         z, dz = s[:3], s[3:]
         tau = computed_torque(body, gains, ref, t, z, dz)
-        F, beta = allocate(tau, z[2], force_limit, angle_limit)
+        F, beta = alloc(tau, z[2])
         out = np.concatenate([dz, config_accel(body, z, dz, F, beta)])
         if not np.all(np.isfinite(out)):
             bad = [n for n, v in zip(("x", "y", "phi", "xdot", "ydot", "phidot"), out) if not np.isfinite(v)]
@@ -112,7 +132,8 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
              force_limit: float | None = None, angle_limit: float | None = None,
              t_eval=None, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
              method: str = "DOP853", max_step: float = np.inf,
-             blowup: float = 1e8, switching: str = "stepsize") -> SimulationResult:
+             blowup: float = 1e8, switching: str = "stepsize", allocation: str = "position",
+             weights=(1.0, 1.0, 0.0)) -> SimulationResult:
     """Integrate the closed loop (2)-(4), (23), (25)-(26) from t = 0 to ``t_end`` (s).
 
     ``z0``, ``dz0``: initial configuration and rate (default: the paper's
@@ -129,6 +150,12 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
     (Filippov), with :class:`lib.limits.SwitchedLoop`. ``"events"`` needs an
     ``angle_limit`` below pi; in the result, ``beta`` while sliding is the
     Filippov average angle and ``mode`` records the side.
+
+    ``allocation`` selects the allocation step: ``"position"`` (default, the
+    paper's (25)-(26)) or ``"least_squares"`` (the weighted law of Chapter 6,
+    :func:`lib.control.allocate_least_squares`, with ``weights`` =
+    (w_x, w_y, w_phi)); see :func:`allocator`. The event-located switching
+    supports the position-only law only.
     """
     if not isinstance(body, Body):
         raise TypeError(f"body must be a lib.params.Body, got {type(body).__name__}")
@@ -149,11 +176,14 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
     allocate(np.zeros(2), 0.0, force_limit, angle_limit)
     if switching not in ("stepsize", "events"):
         raise ValueError(f"switching must be 'stepsize' or 'events', got {switching!r}")
+    alloc = allocator(body, allocation, weights, force_limit, angle_limit)  # validates
     if switching == "events":
+        if allocation != "position":
+            raise ValueError("switching='events' supports allocation='position' only")
         return _simulate_events(body, gains, ref, t_end, z0, dz0, force_limit, angle_limit, t_eval,
                                 rtol, atol, method, max_step)
 
-    rhs = closed_loop_rhs(body, gains, ref, force_limit, angle_limit)
+    rhs = closed_loop_rhs(body, gains, ref, force_limit, angle_limit, allocation=allocation, weights=weights)
 
     def blew_up(t, s):
         return blowup - np.max(np.abs(s))
@@ -172,7 +202,7 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
     z, dz = sol.y[:3].T, sol.y[3:].T
     t = sol.t
     tau = computed_torque(body, gains, ref, t, z, dz)
-    F, beta = allocate(tau, z[:, 2], force_limit, angle_limit)
+    F, beta = alloc(tau, z[:, 2])
     return SimulationResult(t=t, z=z, dz=dz, z_d=ref.z(t), dz_d=ref.dz(t), F=F, beta=beta, tau=tau, ref=ref)
 
 

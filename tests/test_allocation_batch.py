@@ -1,0 +1,77 @@
+"""The batch closed loop of Chapter 6 against the adaptive single-run simulation."""
+
+import numpy as np
+import pytest
+
+from lib import allocation, trajectories as T
+from lib.params import PAPER_DZ0, PAPER_Z0, Body, Gains
+from lib.simulate import simulate
+
+
+@pytest.mark.parametrize("kind,w_phi", [("eight", 1.0), ("circle", 0.3), ("eight", 0.0)])
+def test_batch_rk4_agrees_with_adaptive_simulation(kind, w_phi):
+    body, gains = Body(), Gains()
+    t_end = 20.0
+    batch = allocation.closed_loop_batch(body, gains, kind, 2.0, np.pi / 4, (1.0, 1.0, w_phi), t_end=t_end,
+                                         dt=0.02, record_dt=0.5, z0=PAPER_Z0, dz0=PAPER_DZ0)
+    ref = T.make(kind, 2.0, np.pi / 4)
+    exact = simulate(body, gains, ref, t_end, t_eval=batch.t, allocation="least_squares",
+                     weights=(1.0, 1.0, w_phi), rtol=1e-11, atol=1e-11)
+    assert np.abs(batch.z[:, 0, :] - exact.z).max() < 1e-5
+    np.testing.assert_allclose(batch.F[:, 0], exact.F, atol=1e-4)
+
+
+def test_rk4_error_shrinks_at_fourth_order():
+    body, gains = Body(), Gains()
+    runs = [allocation.closed_loop_batch(body, gains, "eight", 2.0, 1.0, (1, 1, 1), t_end=10.0, dt=dt,
+                                         record_dt=0.4, z0=PAPER_Z0, dz0=PAPER_DZ0) for dt in (0.08, 0.04, 0.02)]
+    e1 = np.abs(runs[0].z - runs[2].z).max()
+    e2 = np.abs(runs[1].z - runs[2].z).max()
+    # against the finest run, the differences of an order-4 scheme shrink by (16 - 1) / (16/16 - 1/16) = 17
+    assert 12.0 < e1 / e2 < 22.0
+
+
+def test_paper_law_from_the_reference_keeps_position_error_at_integration_error():
+    res = allocation.closed_loop_batch(Body(), Gains(), "eight", [1.0, 3.0], [0.5, 1.2], (1, 1, 0), t_end=30.0)
+    assert res.position_error.max() < 1e-7
+
+
+def test_steady_metrics_flag_a_body_that_leaves_the_circle():
+    res = allocation.closed_loop_batch(Body(), Gains(), "circle", 2.0, np.pi / 4, [(1, 1, 0), (1, 1, 10)],
+                                       t_end=100.0, dt=0.02, z0=PAPER_Z0, dz0=PAPER_DZ0)
+    m = allocation.steady_metrics(res)
+    assert m.position_held.tolist() == [True, False]
+    assert m.pos_rms[0] < 1e-6 and m.pos_rms[1] > 10.0
+
+
+def test_steady_metrics_need_enough_periods():
+    res = allocation.closed_loop_batch(Body(), Gains(), "eight", 2.0, 0.1, (1, 1, 0), t_end=20.0)
+    with pytest.raises(ValueError, match="shorter than 3 reference periods"):
+        allocation.steady_metrics(res)
+
+
+@pytest.mark.parametrize("kw,exc,msg", [
+    ({"kind": "square"}, ValueError, "unknown trajectory 'square'"),
+    ({"R": []}, ValueError, "empty"),
+    ({"R": [1.0, -1.0]}, ValueError, "positive finite radius"),
+    ({"Theta": [0.0]}, ValueError, "non-zero"),
+    ({"R": [1.0, 2.0], "Theta": [1.0, 2.0, 3.0]}, ValueError, "equal lengths"),
+    ({"weights": (0.0, 0.0, 0.0)}, ValueError, "not all zero"),
+    ({"t_end": -1.0}, ValueError, "t_end"),
+    ({"body": None}, TypeError, "Body"),
+])
+def test_batch_rejects_bad_input(kw, exc, msg):
+    args = dict(body=Body(), gains=Gains(), kind="eight", R=[1.0], Theta=[1.0], weights=(1, 1, 1), t_end=1.0)
+    args.update(kw)
+    with pytest.raises(exc, match=msg):
+        allocation.closed_loop_batch(**args)
+
+
+def test_simulate_allocation_option_is_validated():
+    with pytest.raises(ValueError, match="unknown allocation 'torque'"):
+        simulate(Body(), Gains(), T.circle(), 1.0, allocation="torque")
+    with pytest.raises(ValueError, match="weights"):
+        simulate(Body(), Gains(), T.circle(), 1.0, allocation="least_squares", weights=(1, 1))
+    with pytest.raises(ValueError, match="supports allocation='position' only"):
+        simulate(Body(), Gains(), T.circle(), 1.0, angle_limit=1.0, switching="events",
+                 allocation="least_squares", weights=(1, 1, 1))
