@@ -1,0 +1,32 @@
+"""Every row of the reproduction report: its check runs and decides the status the book reports."""
+
+import pytest
+
+from lib import report
+
+ITEMS = report.items()
+
+
+@pytest.mark.parametrize("item", ITEMS, ids=[i.key for i in ITEMS])
+def test_report_row_status_is_decided_by_its_check(item):
+    out = item.check()
+    assert out.status == item.expected, f"{item.key}: computed {out.status!r}, book reports {item.expected!r} ({out.note})"
+    if out.status == "corrected":
+        assert out.erratum, f"{item.key}: a corrected row must link its errata row"
+
+
+def test_report_rows_are_unique_and_link_existing_pages():
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    assert len({i.key for i in ITEMS}) == len(ITEMS)
+    for i in ITEMS:
+        assert (root / f"{i.section}.md").exists(), f"{i.key}: no page {i.section}"
+        assert i.expected in report.STATUSES
+
+
+def test_outcome_rejects_unknown_status_and_non_finite_merit():
+    with pytest.raises(ValueError, match="unknown status"):
+        report.Outcome("fine", 0.0, "x")
+    with pytest.raises(ValueError, match="finite"):
+        report.Outcome("reproduced", float("nan"), "x")
