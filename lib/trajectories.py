@@ -43,14 +43,13 @@ class Reference:
 
 
 @dataclass(frozen=True)
-class Circle(Reference):
-    """Circle of radius R (m) run at angular rate theta (rad/s), heading tangent, eq. (27).
-
-    z_d = [R cos(theta t), R sin(theta t), theta t + pi/2].
-    """
+class _Path(Reference):
+    """A closed path of size R (m) run at angular rate theta (rad/s); subclasses
+    name their array-form kinematics in ``_kind`` (a key of :data:`KINEMATICS`)."""
 
     R: float = 2.0
     theta: float = math.pi / 4
+    _kind = ""
 
     def __post_init__(self) -> None:
         R, th = _check_shape(self.R, self.theta)
@@ -61,18 +60,31 @@ class Circle(Reference):
     def period(self) -> float:
         return 2 * math.pi / abs(self.theta)
 
+    def _kin(self, t):
+        return KINEMATICS[self._kind](self.R, self.theta, t)
+
     def z(self, t) -> np.ndarray:
-        return circle_kinematics(self.R, self.theta, t)[0]
+        return self._kin(t)[0]
 
     def dz(self, t) -> np.ndarray:
-        return circle_kinematics(self.R, self.theta, t)[1]
+        return self._kin(t)[1]
 
     def ddz(self, t) -> np.ndarray:
-        return circle_kinematics(self.R, self.theta, t)[2]
+        return self._kin(t)[2]
 
 
 @dataclass(frozen=True)
-class Eight(Reference):
+class Circle(_Path):
+    """Circle of radius R (m) run at angular rate theta (rad/s), heading tangent, eq. (27).
+
+    z_d = [R cos(theta t), R sin(theta t), theta t + pi/2].
+    """
+
+    _kind = "circle"
+
+
+@dataclass(frozen=True)
+class Eight(_Path):
     """Figure eight, eq. (28): x_d = R/2 sin(2 theta t), y_d = R sin(theta t).
 
     The desired heading is the direction of the path's tangent. The paper
@@ -87,30 +99,11 @@ class Eight(Reference):
     with the period of the path and oscillates about pi.
     """
 
-    R: float = 2.0
-    theta: float = math.pi / 4
-
-    def __post_init__(self) -> None:
-        R, th = _check_shape(self.R, self.theta)
-        object.__setattr__(self, "R", R)
-        object.__setattr__(self, "theta", th)
-
-    @property
-    def period(self) -> float:
-        return 2 * math.pi / abs(self.theta)
+    _kind = "eight"
 
     def heading(self, t) -> np.ndarray:
         """Continuous tangent angle phi_d(t) (rad)."""
-        return eight_kinematics(self.R, self.theta, t)[0][..., 2]
-
-    def z(self, t) -> np.ndarray:
-        return eight_kinematics(self.R, self.theta, t)[0]
-
-    def dz(self, t) -> np.ndarray:
-        return eight_kinematics(self.R, self.theta, t)[1]
-
-    def ddz(self, t) -> np.ndarray:
-        return eight_kinematics(self.R, self.theta, t)[2]
+        return self.z(t)[..., 2]
 
 
 def circle_kinematics(R, theta, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
