@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .control import allocate_least_squares, wrap_angle
+from .control import allocate_least_squares, computed_torque_from, wrap_angle
 from .model import config_accel
 from .params import Body, Gains
 from .trajectories import KINEMATICS
@@ -95,12 +95,11 @@ def closed_loop_batch(body: Body, gains: Gains, kind: str, R, Theta, weights=(1.
             raise ValueError(f"{name} must be a positive finite time (s), got {v!r}")
     R, Theta, w = _points(R, Theta, weights)
     kin = KINEMATICS[kind]
-    m = np.array([body.m, body.m, body.I])
 
     def rhs(t, s):
         z, dz = s[:, :3], s[:, 3:]
         zd, dzd, ddzd = kin(R, Theta, t)
-        tau = m * ddzd + body.drag * dz + gains.kv * (dzd - dz) + gains.kp * (zd - z)
+        tau = computed_torque_from(body, gains, zd, dzd, ddzd, z, dz)
         F, beta = allocate_least_squares(tau, z[:, 2], body, w)
         return np.concatenate([dz, config_accel(body, z, dz, F, beta)], axis=1), F
 

@@ -14,7 +14,7 @@ from scipy.linalg import expm
 
 from .params import Body, Gains
 
-__all__ = ["computed_torque", "allocate", "allocate_least_squares", "input_matrix", "wrap_angle",
+__all__ = ["computed_torque", "computed_torque_from", "allocate", "allocate_least_squares", "input_matrix", "wrap_angle",
            "error_dynamics_solution"]
 
 
@@ -32,11 +32,16 @@ def computed_torque(body: Body, gains: Gains, ref, t, z, dz) -> np.ndarray:
     ``dz`` the actual configuration and its rate, shape (..., 3).
     Returns tau = [tau_x (N), tau_y (N), tau_phi (N m)], shape (..., 3).
     """
+    return computed_torque_from(body, gains, ref.z(t), ref.dz(t), ref.ddz(t), z, dz)
+
+
+def computed_torque_from(body: Body, gains: Gains, z_d, dz_d, ddz_d, z, dz) -> np.ndarray:
+    """Eq. (23) from the reference values themselves: z_d, dz_d, ddz_d and the actual
+    z, dz, all of shape (..., 3) (broadcast); see :func:`computed_torque`."""
     z = np.asarray(z, dtype=float)
     dz = np.asarray(dz, dtype=float)
     m = np.array([body.m, body.m, body.I])
-    return (m * ref.ddz(t) + body.drag * dz
-            + gains.kv * (ref.dz(t) - dz) + gains.kp * (ref.z(t) - z))
+    return m * ddz_d + body.drag * dz + gains.kv * (dz_d - dz) + gains.kp * (z_d - z)
 
 
 def allocate(tau, phi, force_limit: float | None = None, angle_limit: float | None = None):

@@ -103,6 +103,7 @@ def allocator(body: Body, allocation: str = "position", weights=(1.0, 1.0, 0.0),
     with ``weights`` = (w_x, w_y, w_phi) (Chapter 6). Limits apply to both.
     """
     if allocation == "position":
+        allocate(np.zeros(2), 0.0, force_limit, angle_limit)  # validate once
         return lambda tau, phi: allocate(tau, phi, force_limit, angle_limit)
     if allocation == "least_squares":
         allocate_least_squares(np.zeros(3), 0.0, body, weights, force_limit, angle_limit)  # validate once
@@ -172,11 +173,9 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
     t_eval = np.asarray(t_eval, dtype=float)
     if t_eval.ndim != 1 or t_eval.size == 0 or t_eval[0] < 0 or t_eval[-1] > t_end or np.any(np.diff(t_eval) <= 0):
         raise ValueError("t_eval must be a non-empty increasing 1-D array within [0, t_end]")
-    # validate limits once, before integrating
-    allocate(np.zeros(2), 0.0, force_limit, angle_limit)
+    alloc = allocator(body, allocation, weights, force_limit, angle_limit)  # validates limits and weights
     if switching not in ("stepsize", "events"):
         raise ValueError(f"switching must be 'stepsize' or 'events', got {switching!r}")
-    alloc = allocator(body, allocation, weights, force_limit, angle_limit)  # validates
     if switching == "events":
         if allocation != "position":
             raise ValueError("switching='events' supports allocation='position' only")
@@ -269,3 +268,27 @@ def simulate_open_loop(body: Body, F, beta, q0, t_end: float, *, form: str = "co
     if form == "config":
         q = state_from_config(q[:, :3], q[:, 3:])
     return sol.t, q
+
+
+def _demo_force(t):
+    return 1.0 + 0.5 * np.sin(t)
+
+
+def _demo_angle(t):
+    return 0.8 * np.sin(0.7 * t)
+
+
+#: initial state of the open-loop comparison: moving forward and turning
+DEMO_Q0 = (0.0, 0.0, 0.0, 0.5, 0.0, 0.2)
+
+
+def open_loop_comparison(body: Body, t_end: float, *, F=_demo_force, beta=_demo_angle,
+                         q0=DEMO_Q0) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """Run every model form of :data:`OPEN_LOOP_FORMS` with the same inputs and initial state.
+
+    Defaults are the smooth inputs of Chapter 1, F(t) = 1 + 0.5 sin t (N) and
+    beta(t) = 0.8 sin 0.7t (rad), from q0 = :data:`DEMO_Q0`, chosen so that the
+    body both translates and turns. Returns (t, {form: q}) with q of shape (n, 6).
+    """
+    runs = {form: simulate_open_loop(body, F, beta, q0, t_end, form=form) for form in OPEN_LOOP_FORMS}
+    return runs["config"][0], {form: q for form, (_, q) in runs.items()}
