@@ -238,14 +238,36 @@ class SwitchedLoop:
 
     # -- integration --
 
+    def _kink_functions(self, t: float, s) -> tuple[float, ...]:
+        """Where the smooth field of a side has a kink (continuous, with a jump in its
+        derivative): |tau| sin(psi -+ beta_max) = 0 at the edges of the angle clip
+        (psi the demand angle to the body axis), and |tau|^2 - F_max^2 = 0 at the
+        force cap (only when a cap is set)."""
+        tx, ty, _ = self._tau(t, s)
+        c, sn = math.cos(s[2]), math.sin(s[2])
+        lat, lon = ty * c - tx * sn, tx * c + ty * sn
+        cb, sb = math.cos(self.bmax), math.sin(self.bmax)
+        out = (lat * cb - lon * sb, lat * cb + lon * sb)
+        if math.isfinite(self.fmax):
+            out += (tx * tx + ty * ty - self.fmax**2,)
+        return out
+
     def integrate(self, s0, t0: float, t1: float, t_eval=None, *, mode: int | None = None,
                   rtol: float = 1e-9, atol: float = 1e-9, method: str = "DOP853",
                   max_step: float = np.inf, max_segments: int = 200_000) -> Segments:
         """Integrate from (t0, s0) to t1 (s), sampling at ``t_eval`` (default: t0 and t1).
 
-        ``mode`` is the starting mode (default :meth:`initial_mode`). Raises
-        ``RuntimeError`` if more than ``max_segments`` smooth pieces are needed
-        (a Zeno-like accumulation of switchings).
+        ``mode`` is the starting mode (default :meth:`initial_mode`). Every
+        non-smooth point is located as an event and the integrator restarted
+        there, so that no step straddles one: the switching surface (a jump of
+        the field), the exits from sliding, and the kinks of the smooth fields
+        (:meth:`_kink_functions`). A step across a kink would cost the
+        high-order method its order without its error estimate noticing, and
+        the global error would stop following the tolerance. An event just
+        crossed is watched only in the opposite direction on restart, so that
+        the restart is not caught by the same root. Raises ``RuntimeError`` if
+        more than ``max_segments`` smooth pieces are needed (a Zeno-like
+        accumulation of switchings).
         """
         s = np.asarray(s0, dtype=float)
         if s.shape != (6,) or not np.all(np.isfinite(s)):
@@ -258,36 +280,38 @@ class SwitchedLoop:
         mode = self.initial_mode(t0, s) if mode is None else int(mode)
         ts, ys, ms = [], [], []
         t = float(t0)
-        first = True
+        i_next = 0  # index of the next sample time in tev
         n_cross = n_slide = 0
         t_slide = 0.0
+        just_crossed: tuple[int, int] | None = None  # (kink index, direction of its crossing)
         for _ in range(max_segments):
-            sel = tev[(tev >= t) if first else (tev > t)]
-            first = False
-            want_end = sel.size > 0 and sel[-1] == t1
-            if not want_end:
-                sel = np.append(sel, t1)  # always return the state at t1
-            fun, events = self._segment(mode)
-            sol = solve_ivp(fun, (t, t1), s, method=method, t_eval=sel, rtol=rtol, atol=atol,
-                            max_step=max_step, events=events)
+            fun, events, n_switch = self._segment(mode, t, s, just_crossed)
+            sol = solve_ivp(fun, (t, t1), s, method=method, rtol=rtol, atol=atol, max_step=max_step,
+                            events=events, dense_output=True)
             if sol.status == -1:
                 raise RuntimeError(f"integration failed at t = {t:.6g} s: {sol.message}")
-            st = np.asarray(sol.t, dtype=float).reshape(-1)
-            sy = np.asarray(sol.y, dtype=float).reshape(6, -1).T
-            keep = slice(None) if (want_end or sol.status == 1) else slice(0, -1)
-            ts.append(st[keep])
-            ys.append(sy[keep])
-            ms.append(np.full(st[keep].size, mode))
-            if sol.status == 0:
-                if mode == 0:
-                    t_slide += t1 - t
-                t, s = t1, sy[-1]
-                break
-            k = next(i for i, te in enumerate(sol.t_events) if te.size)
-            t_new, s = float(sol.t_events[k][0]), sol.y_events[k][0]
+            if sol.status == 1:
+                k = min((i for i, te in enumerate(sol.t_events) if te.size), key=lambda i: sol.t_events[i][0])
+                t_new, s_new = _polish_event(fun, events[k], float(sol.t[-2]), sol.y[:, -2],
+                                             float(sol.t_events[k][0]), method, rtol, atol)
+                i_end = int(np.searchsorted(tev, t_new, side="left"))  # samples before the event
+            else:
+                k, t_new, s_new, i_end = -1, float(t1), sol.y[:, -1], tev.size
+            if i_end > i_next:
+                tt = tev[i_next:i_end]
+                ts.append(tt)
+                ys.append(np.asarray(sol.sol(tt), dtype=float).reshape(6, -1).T)
+                ms.append(np.full(tt.size, mode))
+                i_next = i_end
             if mode == 0:
                 t_slide += t_new - t
-            t = t_new
+            t, s = t_new, np.asarray(s_new, dtype=float)
+            if sol.status == 0:
+                break
+            if k >= n_switch:  # a kink: same field on, restarted; watch this kink the other way only
+                just_crossed = (k - n_switch, -events[k].start_sign)
+                continue
+            just_crossed = None
             mode, crossed, slid = self._after_event(t, s, mode, k)
             n_cross += crossed
             n_slide += slid
@@ -302,7 +326,12 @@ class SwitchedLoop:
                         y_end=np.array(s, dtype=float), mode_end=int(mode), n_crossings=n_cross,
                         n_slides=n_slide, t_sliding=t_slide)
 
-    def _segment(self, mode: int):
+    def _segment(self, mode: int, t0: float, s0, just_crossed):
+        """Field and terminal events of one smooth piece starting at (t0, s0): the
+        switching events of ``mode`` first (their count is returned), then one event
+        per kink. Each kink event records the sign it starts with (``start_sign``),
+        so that the direction of a crossing is known; the kink ``just_crossed``
+        (index, direction of that crossing) is watched in the opposite direction only."""
         if mode == 0:
             def fun(t, s):
                 return self.rhs(t, s, 0)
@@ -315,21 +344,40 @@ class SwitchedLoop:
                 _, rm = self.one_sided_rates(t, s)
                 return rm + self.k_slide * self.lateral(t, s)
 
-            exit_plus.terminal, exit_plus.direction = True, 1
-            exit_minus.terminal, exit_minus.direction = True, -1
-            return fun, [exit_plus, exit_minus]
+            exit_plus.direction, exit_minus.direction = 1, -1
+            switch = [exit_plus, exit_minus]
+            # while sliding beta is the Filippov average, not a clip: only the force cap is a kink
+            kinks = [2] if math.isfinite(self.fmax) else []
+        else:
+            def fun(t, s):
+                return self.rhs(t, s, mode)
 
-        def fun(t, s):
-            return self.rhs(t, s, mode)
+            def hit(t, s):
+                return self.lateral(t, s)
 
-        def hit(t, s):
-            return self.lateral(t, s)
+            hit.direction = -mode
+            switch = [hit]
+            kinks = list(range(len(self._kink_functions(t0, s0))))
+        events = switch + [self._kink_event(j, t0, s0, just_crossed) for j in kinks]
+        for ev in events:
+            ev.terminal = True
+        return fun, events, len(switch)
 
-        hit.terminal, hit.direction = True, -mode
-        return fun, [hit]
+    def _kink_event(self, j: int, t0: float, s0, just_crossed):
+        def kink(t, s):
+            return self._kink_functions(t, s)[j]
+
+        g0 = kink(t0, s0)
+        kink.start_sign = 1 if g0 > 0 else -1
+        if just_crossed is not None and just_crossed[0] == j:  # on the far side now, whatever g0 rounds to
+            kink.start_sign = just_crossed[1]
+            kink.direction = -just_crossed[1]
+        else:
+            kink.direction = 0
+        return kink
 
     def _after_event(self, t: float, s, mode: int, k: int) -> tuple[int, int, int]:
-        """New mode after an event, and whether it was a crossing / the start of a slide."""
+        """New mode after a switching event, and whether it was a crossing / the start of a slide."""
         if mode == 0:
             return (1 if k == 0 else -1), 0, 0
         tx, ty, _ = self._tau(t, s)
@@ -348,6 +396,25 @@ class SwitchedLoop:
         """State and mode at t1 starting from state ``s`` (and ``mode``) at t0."""
         seg = self.integrate(s, t0, t1, mode=mode, **kw)
         return seg.y_end, seg.mode_end
+
+
+def _polish_event(fun, event, t_old: float, y_old, t_e: float, method: str, rtol: float, atol: float):
+    """Time and state of a located event, to the accuracy of a step rather than of the
+    interpolant: the state is integrated from the last step point (t_old, y_old) to the
+    root t_e found on the dense output, then one Newton step on the event function g
+    along the field, dt = -g / (dg/dt), moves both onto g = 0 (dt is of the size of
+    the interpolation error, so the first-order move costs O(dt^2))."""
+    y_e = np.asarray(y_old, dtype=float)
+    if t_e > t_old:
+        y_e = solve_ivp(fun, (t_old, t_e), y_e, method=method, rtol=rtol, atol=atol).y[:, -1]
+    f = np.asarray(fun(t_e, y_e), dtype=float)
+    h = 1e-6 * max(1.0, abs(t_e) * 1e-3)
+    rate = (event(t_e + h, y_e + h * f) - event(t_e - h, y_e - h * f)) / (2 * h)
+    g = event(t_e, y_e)
+    if rate != 0 and abs(g / rate) < 0.5 * (t_e - t_old):
+        dt = -g / rate
+        return t_e + dt, y_e + dt * f
+    return t_e, y_e
 
 
 # ------------------------------------------------------------------ sections and exponents
