@@ -21,9 +21,11 @@ import pandas as pd
 from .control import allocate_least_squares, computed_torque_from, wrap_angle
 from .model import config_accel
 from .params import Body, Gains
+from .robustness import perturbed
+from .stability import eight_rotation_sweep
 from .trajectories import KINEMATICS
 
-__all__ = ["BatchResult", "closed_loop_batch", "steady_metrics"]
+__all__ = ["BatchResult", "closed_loop_batch", "steady_metrics", "MapComparison", "compare_on_map"]
 
 
 @dataclass(frozen=True)
@@ -165,3 +167,47 @@ def steady_metrics(res: BatchResult, n_periods: float = 2.0) -> pd.DataFrame:
                         position_held=bool(drift < 1e-3), F_max=float(F[last, j].max()),
                         F_rms=float(np.sqrt(np.mean(F[last, j] ** 2)))))
     return pd.DataFrame(out)
+
+
+@dataclass(frozen=True)
+class MapComparison:
+    """The two laws on a set of (R, Theta) points of the eight, from one start.
+
+    ``lost`` (N,) bool: the paper's law does not settle to a periodic heading
+    (Chapter 5's classification, :func:`lib.stability.eight_rotation_sweep`);
+    ``held`` (N,) bool: under the weighted law the heading does not slip over the
+    last period and the body stays on the path (:func:`steady_metrics`);
+    ``pos_rms`` (N,) the weighted law's steady position error (m RMS).
+    """
+
+    lost: np.ndarray
+    held: np.ndarray
+    pos_rms: np.ndarray
+
+    @property
+    def counts(self) -> dict:
+        """Points lost under the paper's law, of those held by the weighted law
+        ("rescued"), and periodic under the paper's law but not held ("broken")."""
+        return {"lost": int(self.lost.sum()), "rescued": int((self.lost & self.held).sum()),
+                "broken": int((~self.lost & ~self.held).sum())}
+
+
+def compare_on_map(body: Body, gains: Gains, R, Theta, w_phi: float, *, t_end: float, dt: float = 0.02,
+                   rel: float = 0.0) -> MapComparison:
+    """Classify the paper's law and the weighted law (weights (1, 1, ``w_phi``)) on the eight
+    at the points (R_i (m), Theta_i (rad/s)), both started on the reference; with ``rel``
+    != 0 both starts are moved by :func:`lib.robustness.perturbed` (the heading error of
+    the paper's law by ``rel`` rad and ``rel`` rad/s), to show which verdicts ride on
+    the last bits of a chaotic motion. The weighted law runs for ``t_end`` (s) with
+    RK4 step ``dt`` (s)."""
+    R, Theta, _ = _points(R, Theta, (1.0, 1.0, w_phi))
+    dp0, dv0 = perturbed(np.zeros(2), rel)
+    paper = eight_rotation_sweep(body, R, Theta, p0=dp0, v0=dv0)
+    zd0, dzd0, _ = KINEMATICS["eight"](R, Theta, 0.0)
+    s0 = perturbed(np.concatenate([zd0, dzd0], axis=1), rel)
+    res = closed_loop_batch(body, gains, "eight", R, Theta, (1.0, 1.0, w_phi), t_end=t_end, dt=dt,
+                            record_dt=0.05, z0=s0[:, :3], dz0=s0[:, 3:])
+    m = steady_metrics(res)
+    return MapComparison(lost=paper.regime.to_numpy() != "periodic",
+                         held=m.heading_held.to_numpy() & m.position_held.to_numpy(),
+                         pos_rms=m.pos_rms.to_numpy())

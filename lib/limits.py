@@ -42,7 +42,7 @@ from .trajectories import Circle, Eight, Reference
 __all__ = [
     "SwitchedLoop", "Segments", "reference_kinematics", "error_state", "stroboscopic_section",
     "largest_lyapunov", "LyapunovEstimate", "distinct_points", "classify", "Regime", "sweep_angle_limit",
-    "section_sweep", "section_period", "damped_oscillator_flow", "driven_pendulum_flow", "state_difference",
+    "section_sweep", "section_period", "section_margin", "damped_oscillator_flow", "driven_pendulum_flow", "state_difference",
 ]
 
 TWO_PI = 2.0 * math.pi
@@ -284,14 +284,20 @@ class SwitchedLoop:
         n_cross = n_slide = 0
         t_slide = 0.0
         just_crossed: tuple[int, int] | None = None  # (kink index, direction of its crossing)
+        muted: set[int] = set()  # kinks grazed at the start of this segment
         for _ in range(max_segments):
-            fun, events, n_switch = self._segment(mode, t, s, just_crossed)
+            fun, events, n_switch = self._segment(mode, t, s, just_crossed, muted)
             sol = solve_ivp(fun, (t, t1), s, method=method, rtol=rtol, atol=atol, max_step=max_step,
                             events=events, dense_output=True)
             if sol.status == -1:
                 raise RuntimeError(f"integration failed at t = {t:.6g} s: {sol.message}")
             if sol.status == 1:
                 k = min((i for i, te in enumerate(sol.t_events) if te.size), key=lambda i: sol.t_events[i][0])
+                if k >= n_switch and sol.t_events[k][0] - t <= _GRAZE * max(1.0, abs(t)):
+                    # a kink function touching zero where the segment starts (a double root):
+                    # run this segment without it; a kink grazed for so short a time costs nothing
+                    muted.add(events[k].index)
+                    continue
                 t_new, s_new = _polish_event(fun, events[k], float(sol.t[-2]), sol.y[:, -2],
                                              float(sol.t_events[k][0]), method, rtol, atol)
                 i_end = int(np.searchsorted(tev, t_new, side="left"))  # samples before the event
@@ -306,10 +312,11 @@ class SwitchedLoop:
             if mode == 0:
                 t_slide += t_new - t
             t, s = t_new, np.asarray(s_new, dtype=float)
+            muted = set()
             if sol.status == 0:
                 break
             if k >= n_switch:  # a kink: same field on, restarted; watch this kink the other way only
-                just_crossed = (k - n_switch, -events[k].start_sign)
+                just_crossed = (events[k].index, -events[k].start_sign)
                 continue
             just_crossed = None
             mode, crossed, slid = self._after_event(t, s, mode, k)
@@ -326,12 +333,13 @@ class SwitchedLoop:
                         y_end=np.array(s, dtype=float), mode_end=int(mode), n_crossings=n_cross,
                         n_slides=n_slide, t_sliding=t_slide)
 
-    def _segment(self, mode: int, t0: float, s0, just_crossed):
+    def _segment(self, mode: int, t0: float, s0, just_crossed, muted=frozenset()):
         """Field and terminal events of one smooth piece starting at (t0, s0): the
         switching events of ``mode`` first (their count is returned), then one event
         per kink. Each kink event records the sign it starts with (``start_sign``),
         so that the direction of a crossing is known; the kink ``just_crossed``
-        (index, direction of that crossing) is watched in the opposite direction only."""
+        (index, direction of that crossing) is watched in the opposite direction only,
+        and the kinks in ``muted`` are not watched."""
         if mode == 0:
             def fun(t, s):
                 return self.rhs(t, s, 0)
@@ -358,7 +366,7 @@ class SwitchedLoop:
             hit.direction = -mode
             switch = [hit]
             kinks = list(range(len(self._kink_functions(t0, s0))))
-        events = switch + [self._kink_event(j, t0, s0, just_crossed) for j in kinks]
+        events = switch + [self._kink_event(j, t0, s0, just_crossed) for j in kinks if j not in muted]
         for ev in events:
             ev.terminal = True
         return fun, events, len(switch)
@@ -367,6 +375,7 @@ class SwitchedLoop:
         def kink(t, s):
             return self._kink_functions(t, s)[j]
 
+        kink.index = j
         g0 = kink(t0, s0)
         kink.start_sign = 1 if g0 > 0 else -1
         if just_crossed is not None and just_crossed[0] == j:  # on the far side now, whatever g0 rounds to
@@ -396,6 +405,10 @@ class SwitchedLoop:
         """State and mode at t1 starting from state ``s`` (and ``mode``) at t0."""
         seg = self.integrate(s, t0, t1, mode=mode, **kw)
         return seg.y_end, seg.mode_end
+
+
+#: a kink event this close (relative, in s) to the start of its segment is a grazing touch
+_GRAZE = 1e-10
 
 
 def _polish_event(fun, event, t_old: float, y_old, t_e: float, method: str, rtol: float, atol: float):
@@ -469,21 +482,54 @@ def section_period(points, tol: float, max_period: int = 8) -> tuple[int, bool]:
     """Smallest period k <= ``max_period`` of a stroboscopic sequence, and whether it is
     still converging: (k, False) if the last points repeat every k periods within
     ``tol`` (max-norm); (k, True) if d_j = |P_(j+k) - P_j| shrinks strictly at every
-    step over the second half of the sequence, at least 8 steps (a periodic orbit
-    approached slowly; fewer steps could shrink by chance);
-    (0, False) if neither holds for any k."""
+    step over the second half of the sequence (at least 8 steps; fewer could shrink
+    by chance) *towards zero*: the Aitken extrapolation of its limit,
+    d_n - (d_n - d_(n-1))^2 / (d_n - 2 d_(n-1) + d_(n-2)), is below ``tol``. (A
+    period-2k orbit approached from one side makes the lag-k distances shrink
+    strictly too, but towards the orbit's non-zero spread: that is not convergence
+    to period k.) (0, False) if neither holds for any k."""
     pts = np.atleast_2d(np.asarray(points, dtype=float))
     n = pts.shape[0]
     if n < 4:
         raise ValueError("need at least 4 section points")
+    if not (np.isfinite(tol) and tol > 0):
+        raise ValueError(f"tol must be a positive distance, got {tol!r}")
     for k in range(1, min(max_period, n // 2) + 1):
         d = np.max(np.abs(pts[k:] - pts[:-k]), axis=1)
         tail = d[len(d) // 2:]
         if np.all(tail[-k:] <= tol):
             return k, False
-        if tail.size >= 8 and np.all(np.diff(tail) < 0):
+        if tail.size >= 8 and np.all(np.diff(tail) < 0) and _aitken_limit(tail) <= tol:
             return k, True
     return 0, False
+
+
+def section_margin(points, tol: float, max_period: int = 8) -> float:
+    """How decisively :func:`section_period` decides a sequence, as a factor on ``tol``:
+    for a period k found (not converging), ``tol`` over the distance at which the last
+    points repeat every k periods; for none found, the smallest distance |P_(j+k) - P_j|
+    over the second half at any lag k <= ``max_period``, over ``tol``; NaN for a
+    sequence still converging (decided by :func:`section_period`'s extrapolation).
+    A margin of 30 means the verdict would survive errors 30 times the tolerance."""
+    pts = np.atleast_2d(np.asarray(points, dtype=float))
+    k, converging = section_period(pts, tol, max_period)
+    if converging:
+        return math.nan
+    if k:
+        d = np.max(np.abs(pts[k:] - pts[:-k]), axis=1)
+        return float(tol / max(d[len(d) // 2:][-k:].max(), 1e-300))
+    lags = range(1, min(max_period, pts.shape[0] // 2) + 1)
+    return float(min(np.max(np.abs(pts[j:] - pts[:-j]), axis=1)[(pts.shape[0] - j) // 2:].min()
+                     for j in lags) / tol)
+
+
+def _aitken_limit(d: np.ndarray) -> float:
+    """Aitken's delta-squared estimate of the limit of a sequence from its last three terms."""
+    d2, d1, d0 = d[-3], d[-2], d[-1]
+    den = d0 - 2 * d1 + d2
+    if den == 0:
+        return float(d0)
+    return float(d0 - (d0 - d1) ** 2 / den)
 
 
 @dataclass(frozen=True)

@@ -311,8 +311,10 @@ def _check_chaos() -> Outcome:
     from .trajectories import eight
 
     reg = sweep_angle_limit(Body(), Gains(), eight(), np.radians([20.0]), n_transient=15, n_points=16,
-                            n_lyap=30, rtol=1e-8, atol=1e-8)[0]
-    return Outcome(_status(reg.verdict == "chaotic", "reproduced"), reg.lyapunov,
+                            n_lyap=48, rtol=1e-8, atol=1e-8)[0]
+    # chaotic with a margin: twice the 3-standard-error threshold (measured 9-11 standard errors)
+    ok = reg.verdict == "chaotic" and reg.lyapunov > 6 * reg.lyapunov_stderr
+    return Outcome(_status(ok, "reproduced"), reg.lyapunov,
                    "largest Lyapunov exponent (1/s), angle limit 20 deg, eight",
                    "chaos found at small angle limits; no quasi-periodic regime was found (Chapter 4)")
 

@@ -8,7 +8,10 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
+
+from lib.robustness import ROBUST_REL, perturbed
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -23,3 +26,25 @@ def built_book() -> subprocess.CompletedProcess:
     (ROOT / "_build").mkdir(exist_ok=True)
     (ROOT / "_build" / "build.log").write_text(proc.stdout + "\n" + proc.stderr)
     return proc
+
+
+# ------------------------------------------------------------------ robustness mode
+#
+# Every test that decides a verdict on a chaotic or switched motion takes the
+# ``perturb`` fixture and applies it to its initial state. The fixture runs the
+# test twice: once from the nominal start, once from the start moved by a relative
+# 1e-12 (the size of a few ulps' worth of difference between two CPUs or libms
+# after a few operations). A verdict that flips is one that rode on the last bits.
+
+@pytest.fixture(params=[0.0, ROBUST_REL], ids=["nominal", "perturbed-1e-12"])
+def perturb(request):
+    """The robustness mode: a function x -> x (nominal run) or x perturbed by a relative 1e-12."""
+    rel = request.param
+    return (lambda x: np.asarray(x, dtype=float)) if rel == 0 else (lambda x: perturbed(x, rel))
+
+
+def pytest_collection_modifyitems(config, items):
+    """Mark every test that uses the robustness mode, so that ``pytest -m robustness`` runs them alone."""
+    for item in items:
+        if "perturb" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.robustness)

@@ -75,3 +75,17 @@ def test_simulate_allocation_option_is_validated():
     with pytest.raises(ValueError, match="supports allocation='position' only"):
         simulate(Body(), Gains(), T.circle(), 1.0, angle_limit=1.0, switching="events",
                  allocation="least_squares", weights=(1, 1, 1))
+
+
+def test_map_comparison_classifies_both_laws_from_the_same_start():
+    from lib import stability
+
+    R, Th = np.array([3.0, 0.25]), np.array([0.3, 1.0])
+    cmp = allocation.compare_on_map(Body(), Gains(), R, Th, 0.1, t_end=3 * 2 * np.pi / 0.3 + 20.0)
+    paper = stability.eight_rotation_sweep(Body(), R, Th)
+    np.testing.assert_array_equal(cmp.lost, paper.regime.to_numpy() != "periodic")
+    assert cmp.counts == {"lost": int(cmp.lost.sum()), "rescued": int((cmp.lost & cmp.held).sum()),
+                          "broken": int((~cmp.lost & ~cmp.held).sum())}
+    assert cmp.lost.tolist() == [False, True]   # a slow wide eight settles, a fast tight one slips
+    with pytest.raises(ValueError, match="R"):
+        allocation.compare_on_map(Body(), Gains(), [-1.0], [0.3], 0.1, t_end=10.0)

@@ -65,11 +65,12 @@ def test_circle_functions_reject_bad_input(R, theta):
         stability.circle_equilibria(BODY, R, theta)
 
 
-def test_below_critical_radius_the_rotation_slips():
+def test_below_critical_radius_the_rotation_slips(perturb):
     theta = 1.0
     r_crit = stability.circle_critical_radius(BODY, theta)
+    p0, v0 = perturb([0.0, 0.0])
     df = stability.circle_final_state(BODY, [0.8 * r_crit, 0.99 * r_crit, 1.01 * r_crit, 2.0 * r_crit],
-                                      theta, 0.0, 0.0)
+                                      theta, p0, v0)
     assert list(df.regime) == ["slipping", "slipping", "settled", "settled"]
 
 
@@ -87,29 +88,31 @@ def test_reduced_rotation_matches_full_closed_loop(kind, R, theta, dp0, dv0):
     np.testing.assert_allclose(res.rotation_error(), p, atol=1e-7)
 
 
-def test_sweep_matches_per_point_solve_ivp_on_full_closed_loop():
+def test_sweep_matches_per_point_solve_ivp_on_full_closed_loop(perturb):
     R, Th = np.array([1.0, 3.0]), np.array([0.8, 0.3])
-    df = stability.eight_rotation_sweep(BODY, R, Th)
+    dp0, dv0 = perturb([0.0, 0.0])
+    df = stability.eight_rotation_sweep(BODY, R, Th, p0=dp0, v0=dv0)
     assert list(df.regime) == ["periodic", "periodic"]
     for row in df.itertuples():
         ref = trajectories.eight(row.R, row.Theta)
         T = 2 * math.pi / row.Theta
         t_last = T * (row.periods - 1) + T * np.arange(1, row.steps + 1) / row.steps
-        res = simulate.simulate(BODY, Gains(), ref, float(t_last[-1]), z0=ref.z(0.0), dz0=ref.dz(0.0),
-                                t_eval=t_last)
+        res = simulate.simulate(BODY, Gains(), ref, float(t_last[-1]), z0=ref.z(0.0) + [0, 0, dp0],
+                                dz0=ref.dz(0.0) + [0, 0, dv0], t_eval=t_last)
         p = res.rotation_error()
         dp_ds = (res.dz[:, 2] - res.dz_d[:, 2]) / row.Theta
         r_ref = stability.sampled_range(p[None], dy=dp_ds[None], h=2 * math.pi / row.steps)[0]
         assert row.range == pytest.approx(r_ref, abs=1e-6)
         # and the refined range is that of the continuous signal: finer samples agree
-        fine = stability.eight_rotation_sweep(BODY, [row.R], [row.Theta], h_lambda=0.03)
+        fine = stability.eight_rotation_sweep(BODY, [row.R], [row.Theta], h_lambda=0.03, p0=dp0, v0=dv0)
         assert fine["range"][0] == pytest.approx(row.range, abs=1e-6)
 
 
-def test_sweep_engines_agree_and_rows_keep_order():
+def test_sweep_engines_agree_and_rows_keep_order(perturb):
     R, Th = np.array([3.0, 1.0, 2.0]), np.array([0.2, 0.8, 0.6])    # periodic points (chaos would
-    a = stability.eight_rotation_sweep(BODY, R, Th, max_periods=20)
-    b = stability.eight_rotation_sweep(BODY, R, Th, max_periods=20, engine="numpy")  # amplify rounding)
+    p0 = perturb(np.zeros(3))                                          # amplify rounding)
+    a = stability.eight_rotation_sweep(BODY, R, Th, max_periods=20, p0=p0)
+    b = stability.eight_rotation_sweep(BODY, R, Th, max_periods=20, engine="numpy", p0=p0)
     np.testing.assert_array_equal(a.R, R)
     np.testing.assert_array_equal(a.Theta, Th)
     np.testing.assert_allclose(a["range"], b["range"], atol=1e-9)
@@ -157,10 +160,11 @@ def test_heading_fourier_matches_paper_series_to_printed_digits():
     np.testing.assert_allclose(a[[2, 4, 6]], 0.0, atol=1e-12)   # only odd harmonics
 
 
-def test_slipping_coexists_only_near_critical_radius_at_high_rate():
+def test_slipping_coexists_only_near_critical_radius_at_high_rate(perturb):
     r_crit = stability.circle_critical_radius(BODY, 1.5)
     coexists = stability.circle_slipping_coexists(BODY, r_crit * np.array([1.05, 3.0]), 1.5)
     assert list(coexists) == [True, False]
     # a slipping motion from a fast initial spin confirms the coexistence at 1.05 R_crit
-    df = stability.circle_final_state(BODY, 1.05 * r_crit, 1.5, 0.0, [-6.0, 0.0], t_end=300.0)
+    p0, v0a, v0b = perturb([0.0, -6.0, 0.0])
+    df = stability.circle_final_state(BODY, 1.05 * r_crit, 1.5, p0, [v0a, v0b], t_end=300.0)
     assert set(df.regime) == {"slipping", "settled"}
