@@ -20,8 +20,13 @@ segments on either side, integrated with a smooth continuation of the side's
 vector field and ended by event location on lat = 0; at S, a crossing if both
 one-sided fields cross S in the same direction, otherwise sliding with the
 convex combination of the two fields that keeps the solution on S, until one
-of them turns away from S. The force cap F <= F_max only makes the field
-non-smooth (a kink), not discontinuous, and needs no special treatment.
+of them turns away from S. Each side's field is continuous but has kinks,
+where the clip starts or stops binding (|psi| = beta_max) and where the force
+cap F <= F_max does; these are located as events too and the integrator
+restarted there, since a step straddling a kink loses the method's order
+without its error estimate noticing. Event states are integrated from the last
+step point, not interpolated, so that the global error follows the tolerance
+across crossings and slides (``tests/test_limits.py`` measures it).
 
 Lyapunov exponents follow Benettin et al. {cite}`benettin1980` with two
 trajectories renormalised once per period.
@@ -484,10 +489,13 @@ def section_period(points, tol: float, max_period: int = 8) -> tuple[int, bool]:
     ``tol`` (max-norm); (k, True) if d_j = |P_(j+k) - P_j| shrinks strictly at every
     step over the second half of the sequence (at least 8 steps; fewer could shrink
     by chance) *towards zero*: the Aitken extrapolation of its limit,
-    d_n - (d_n - d_(n-1))^2 / (d_n - 2 d_(n-1) + d_(n-2)), is below ``tol``. (A
-    period-2k orbit approached from one side makes the lag-k distances shrink
-    strictly too, but towards the orbit's non-zero spread: that is not convergence
-    to period k.) (0, False) if neither holds for any k."""
+    d_n - (d_n - d_(n-1))^2 / (d_n - 2 d_(n-1) + d_(n-2)), is below ``tol`` or
+    below half the last distance d_n. (A period-2k orbit approached from one side
+    makes the lag-k distances shrink strictly too, but towards the orbit's non-zero
+    spread, and the extrapolated limit is then close to d_n itself; a slow geometric
+    approach to an orbit, whose ratio still creeps up towards the slowest
+    multiplier, extrapolates to a small fraction of d_n.) (0, False) if neither
+    holds for any k."""
     pts = np.atleast_2d(np.asarray(points, dtype=float))
     n = pts.shape[0]
     if n < 4:
@@ -499,7 +507,7 @@ def section_period(points, tol: float, max_period: int = 8) -> tuple[int, bool]:
         tail = d[len(d) // 2:]
         if np.all(tail[-k:] <= tol):
             return k, False
-        if tail.size >= 8 and np.all(np.diff(tail) < 0) and _aitken_limit(tail) <= tol:
+        if tail.size >= 8 and np.all(np.diff(tail) < 0) and _aitken_limit(tail) <= max(tol, 0.5 * tail[-1]):
             return k, True
     return 0, False
 
