@@ -41,13 +41,14 @@ from typing import Callable
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from .control import wrap_angle
 from .params import Body, Gains
 from .trajectories import Circle, Eight, Reference
 
 __all__ = [
     "SwitchedLoop", "Segments", "reference_kinematics", "error_state", "stroboscopic_section",
     "largest_lyapunov", "LyapunovEstimate", "distinct_points", "classify", "Regime", "sweep_angle_limit",
-    "section_sweep", "section_period", "section_margin", "damped_oscillator_flow", "driven_pendulum_flow", "state_difference",
+    "section_sweep", "section_period", "section_margin", "state_difference",
 ]
 
 TWO_PI = 2.0 * math.pi
@@ -441,7 +442,7 @@ def _polish_event(fun, event, t_old: float, y_old, t_e: float, method: str, rtol
 def state_difference(a, b) -> np.ndarray:
     """a - b for states [x, y, phi, xdot, ydot, phidot] with the phi entry wrapped to (-pi, pi]."""
     d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
-    d[..., 2] = np.pi - np.mod(np.pi - d[..., 2], TWO_PI)
+    d[..., 2] = wrap_angle(d[..., 2])
     return d
 
 
@@ -453,7 +454,7 @@ def error_state(ref: Reference, t, y) -> np.ndarray:
     y = np.atleast_2d(np.asarray(y, dtype=float))
     zd, dzd = ref.z(t), ref.dz(t)
     p = y[:, 2] - zd[:, 2]
-    p = np.pi - np.mod(np.pi - p, TWO_PI)
+    p = wrap_angle(p)
     return np.column_stack([zd[:, 0] - y[:, 0], zd[:, 1] - y[:, 1], dzd[:, 0] - y[:, 3], dzd[:, 1] - y[:, 4],
                             p, y[:, 5] - dzd[:, 2]])
 
@@ -596,32 +597,6 @@ def largest_lyapunov(flow: Callable, x0, dt: float, n_steps: int, *, d0: float =
     rates = logs / dt
     return LyapunovEstimate(value=float(rates.mean()), stderr=float(rates.std(ddof=1) / math.sqrt(n_steps)),
                             running=np.cumsum(logs) / (dt * np.arange(1, n_steps + 1)))
-
-
-def damped_oscillator_flow(zeta: float = 0.1, omega: float = 1.0) -> Callable:
-    """Flow of x'' + 2 zeta omega x' + omega^2 x = 0 (exact, via the matrix exponential);
-    its Lyapunov exponents are -zeta omega (twice, for zeta < 1)."""
-    from scipy.linalg import expm
-
-    A = np.array([[0.0, 1.0], [-omega**2, -2 * zeta * omega]])
-
-    def flow(x, t0, t1):
-        return expm(A * (t1 - t0)) @ np.asarray(x, dtype=float)
-    return flow
-
-
-def driven_pendulum_flow(q: float = 2.0, g: float = 1.5, omega_d: float = 2.0 / 3.0,
-                         rtol: float = 1e-10, atol: float = 1e-10) -> Callable:
-    """Flow of the driven damped pendulum of Baker & Gollub {cite}`baker1996`,
-    theta'' + theta'/q + sin(theta) = g cos(omega_d t), state (theta, theta').
-    Their q = 2, g = 1.5, omega_d = 2/3 is chaotic."""
-
-    def rhs(t, x):
-        return [x[1], -x[1] / q - math.sin(x[0]) + g * math.cos(omega_d * t)]
-
-    def flow(x, t0, t1):
-        return solve_ivp(rhs, (t0, t1), x, method="DOP853", rtol=rtol, atol=atol).y[:, -1]
-    return flow
 
 
 # ------------------------------------------------------------------ regimes

@@ -28,6 +28,7 @@ import numpy as np
 import pandas as pd
 import sympy as sp
 
+from .control import wrap_angle
 from .params import Body
 from .symbolic import parameter_symbols
 
@@ -177,8 +178,7 @@ def circle_equilibria(body: Body, R: float, theta: float) -> tuple[float, float]
                          f"R_crit = {r_crit:.6g} m of (36) at theta = {theta!r} rad/s")
     k = min(r_crit / R, 1.0)
     gamma = math.atan(body.m * theta / body.c)
-    wrap = lambda x: math.pi - (math.pi - x) % (2 * math.pi)  # noqa: E731
-    return wrap(gamma - math.asin(k)), wrap(gamma + math.pi + math.asin(k))
+    return float(wrap_angle(gamma - math.asin(k))), float(wrap_angle(gamma + math.pi + math.asin(k)))
 
 
 def circle_jacobian(body: Body, R: float, theta: float, p0: float) -> np.ndarray:
@@ -771,6 +771,20 @@ def _check_eq37():
                    detail=f"printed minus derived right side is nonzero: {sp.sstr(sp.factor(diff))}")
 
 
+def _check_fourier_digits():
+    """The printed coefficients of the tangent angle's 3-term series against the
+    computed ones rounded to the printed two decimals, compared as whole hundredths."""
+    from .errata import Verdict
+
+    a = eight_heading_fourier(5)
+    computed = {k: int(round(100 * a[k])) for k in (1, 3, 5)}
+    printed = {k: int(round(100 * PAPER_HEADING_SERIES[k])) for k in (1, 3, 5)}
+    corrected = {1: -226, 3: -23, 5: 16}
+    return Verdict(printed_holds=printed == computed, corrected_holds=corrected == computed,
+                   detail=(f"computed a1, a3, a5 = {a[1]:.4f}, {a[3]:.4f}, {a[5]:.4f}; in hundredths "
+                           f"{computed}, printed {printed}"))
+
+
 def _errata():
     from .errata import Erratum
 
@@ -802,6 +816,15 @@ def _errata():
                         "the reduced equation against the full closed loop "
                         "(`tests/test_stability.py::test_reduced_rotation_matches_full_closed_loop`)",
             section=sec, check=_check_eq37),
+        Erratum(
+            key="fourier-a3",
+            where="Sec. 6, the 3-term series of the eight's tangent angle",
+            printed=r"$-0.24\cos 3\Theta t$",
+            corrected=r"$-0.23\cos 3\Theta t$ (the computed $a_3$ rounded to two decimals, as $a_1$ and $a_5$ are)",
+            verified_by="FFT of the continuous tangent angle (`lib.stability.eight_heading_fourier`), "
+                        "compared with the printed digits as whole hundredths "
+                        "(`lib.stability._check_fourier_digits`)",
+            section=sec, check=_check_fourier_digits),
     ]
 
 

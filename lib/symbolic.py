@@ -19,7 +19,7 @@ import sympy as sp
 __all__ = [
     "SymbolicModel", "derive_body_frame", "printed_drift", "parameter_symbols",
     "Bracket", "lie_bracket", "evaluate_bracket", "bracket_latex", "bracket_degree",
-    "accessibility_matrix", "model_fields", "printed_brackets", "compare_printed_brackets",
+    "accessibility_matrix", "model_fields", "printed_brackets", "compare_printed_brackets", "rank_determinants",
 ]
 
 
@@ -488,6 +488,42 @@ def _entry_rows():
     return out
 
 
+RANK_BRACKETS = ["f", "g1", "g2", ("f", "g1"), ("f", "g2"), ("g1", ("f", "g2"))]
+
+
+def rank_determinants(model: SymbolicModel | None = None) -> dict[str, sp.Expr]:
+    """det C of the distribution (21), factored: ``"printed"`` with the drift (6) and the
+    three bracket columns exactly as printed under (21), ``"derived"`` with every column
+    computed from the derived model."""
+    model = model or derive_body_frame()
+    fields = model_fields(model)
+    pb = printed_brackets(model)
+    printed = sp.Matrix.hstack(printed_drift(model), fields["g1"], fields["g2"],
+                               *(pb[b] for b in RANK_BRACKETS[3:]))
+    derived = accessibility_matrix(fields, RANK_BRACKETS, model.q)
+    return {"printed": sp.factor(sp.simplify(printed.det())), "derived": sp.factor(sp.simplify(derived.det()))}
+
+
+def _check_rank_condition():
+    """The paper's exceptional set omega = a m v2 / I_C against the zero set of det C,
+    with the printed columns of (21) and with the derived ones."""
+    from .errata import Verdict
+
+    model = derive_body_frame()
+    p = model.params
+    _, _, _, _, v2, w = model.q
+    claim = p["a"] * p["m"] * v2 - p["I"] * w
+    dets = rank_determinants(model)
+
+    def matches(det):  # det C = const * claim with a nonzero constant free of the state
+        ratio = sp.simplify(det / claim)
+        return not ratio.free_symbols & set(model.q) and ratio != 0
+
+    return Verdict(printed_holds=matches(dets["printed"]), corrected_holds=matches(dets["derived"]),
+                   detail=f"det C with the printed columns: {sp.sstr(dets['printed'])}; "
+                          f"with the derived ones: {sp.sstr(dets['derived'])}")
+
+
 def _errata():
     from .errata import Erratum
 
@@ -547,6 +583,17 @@ def _errata():
                         "(`lib.controllability.rest_report`); configuration rates free of inputs",
             section="chapters/02_controllability",
             check=_check_conclusion,
+        ),
+        Erratum(
+            key="sec3-rank-condition",
+            where="Sec. 3, the rank condition stated after (21)",
+            printed=r"$\mathrm{rank}\,C = 6$ for $\omega \ne \frac{am}{I_C}v_2$, from the columns of (21) as printed",
+            corrected=r"the condition holds for the derived columns; with the printed ones "
+                      r"$\det C \propto a m v_2\cos 2\varphi + a m v_1 \sin 2\varphi - I_C\omega\cos 2\varphi$",
+            verified_by="sympy determinants of $C$ with the printed and the derived bracket columns "
+                        "(`lib.symbolic.rank_determinants`)",
+            section="chapters/02_controllability",
+            check=_check_rank_condition,
         ),
     ]
 

@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 from scipy.optimize import brentq
 
-from .control import error_dynamics_solution
+from .control import error_dynamics_solution, wrap_angle
 from .params import Body, Gains
 from .simulate import SimulationResult, simulate
 from .trajectories import Reference, make
@@ -61,7 +61,7 @@ def rotation_error_continuous(res: SimulationResult) -> np.ndarray:
     """Rotation error p = phi - phi_d (rad), continuous in time, shifted by a multiple of
     2 pi so that its final value lies in (-pi, pi]."""
     p = np.unwrap(res.rotation_error())
-    shift = 2 * np.pi * np.round((p[-1] - (np.pi - np.mod(np.pi - p[-1], 2 * np.pi))) / (2 * np.pi))
+    shift = 2 * np.pi * np.round((p[-1] - wrap_angle(p[-1])) / (2 * np.pi))
     return p - shift
 
 

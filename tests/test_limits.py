@@ -2,7 +2,9 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings, strategies as st_
 
+from flows import damped_oscillator_flow, driven_pendulum_flow
 from lib import limits as L, trajectories as T
 from lib.params import Body, Gains
 from lib.simulate import simulate
@@ -11,7 +13,7 @@ S0 = np.array([1.0, 0.0, math.pi / 2, 0.0, 0.0, 0.0])
 
 
 def test_lyapunov_estimate_is_negative_for_damped_linear_system():
-    est = L.largest_lyapunov(L.damped_oscillator_flow(zeta=0.1), np.array([1.0, 0.0]), 1.0, 60)
+    est = L.largest_lyapunov(damped_oscillator_flow(zeta=0.1), np.array([1.0, 0.0]), 1.0, 60)
     assert est.value < 0
     assert abs(est.value - (-0.1)) < 0.02
 
@@ -19,14 +21,14 @@ def test_lyapunov_estimate_is_negative_for_damped_linear_system():
 def test_lyapunov_estimate_is_positive_for_baker_gollub_chaotic_pendulum(perturb):
     # a positive exponent by a margin: the verdict threshold is 3 standard errors and the
     # test asks for 6 (measured 8-10 over 200 periods, nominal and perturbed)
-    flow = L.driven_pendulum_flow(q=2.0, g=1.5, omega_d=2 / 3, rtol=1e-9, atol=1e-9)
+    flow = driven_pendulum_flow(q=2.0, g=1.5, omega_d=2 / 3, rtol=1e-9, atol=1e-9)
     est = L.largest_lyapunov(flow, perturb([0.2, 0.0]), 3 * math.pi, 200, n_transient=10)
     assert est.value > 6 * est.stderr and est.value > 0.05, (est.value, est.stderr)
 
 
 def test_lyapunov_estimate_is_negative_for_periodic_pendulum(perturb):
     # Baker & Gollub's g = 0.9 (q = 2) is a stable periodic motion: measured -0.24 +- 0.025 1/s
-    flow = L.driven_pendulum_flow(q=2.0, g=0.9, omega_d=2 / 3, rtol=1e-9, atol=1e-9)
+    flow = driven_pendulum_flow(q=2.0, g=0.9, omega_d=2 / 3, rtol=1e-9, atol=1e-9)
     est = L.largest_lyapunov(flow, perturb([0.2, 0.0]), 3 * math.pi, 30, n_transient=10)
     assert est.value < -3 * est.stderr, (est.value, est.stderr)
 
@@ -193,3 +195,27 @@ def test_section_margin_measures_distance_from_the_tolerance():
     assert 1.0 < L.section_margin(rot, 1e-4) < np.inf          # no period: distance at the nearest lag
     conv = np.array([[0.5 + 0.9**j, 1.0] for j in range(20)])
     assert np.isnan(L.section_margin(conv, 1e-8))             # converging: decided by extrapolation
+
+
+@settings(max_examples=40, deadline=None)
+@given(t=st_.floats(0.0, 50.0), s=st_.lists(st_.floats(-5.0, 5.0), min_size=6, max_size=6),
+       kind=st_.sampled_from(["circle", "eight"]), F=st_.floats(0.0, 10.0), beta=st_.floats(-3.0, 3.0))
+def test_switched_loop_scalar_fast_path_is_eqs_23_and_2_4(t, s, kind, F, beta):
+    # SwitchedLoop keeps scalar copies of (23), (2)-(4) and (27)-(28) for speed; they must
+    # be the library's single definitions at every state
+    from lib.control import computed_torque
+    from lib.model import config_accel
+
+    ref = T.make(kind, 1.7, 0.6)
+    loop = L.SwitchedLoop(Body(), Gains(), ref, 0.5)
+    s = np.array(s)
+    tx, ty, _ = loop._tau(t, s)
+    tau = computed_torque(Body(), Gains(), ref, t, s[:3], s[3:])
+    np.testing.assert_allclose([tx, ty], tau[:2], rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(loop._accel(s, F, beta), config_accel(Body(), s[:3], s[3:], F, beta),
+                               rtol=1e-12, atol=1e-12)
+    kin = L.reference_kinematics(ref)(t)
+    np.testing.assert_allclose(kin[:6], np.r_[ref.z(t)[:2], ref.dz(t)[:2], ref.ddz(t)[:2]], rtol=1e-12, atol=1e-12)
+    h = 1e-4
+    jerk = (ref.ddz(t + h) - ref.ddz(t - h)) / (2 * h)
+    np.testing.assert_allclose(kin[6:], jerk[:2], rtol=1e-6, atol=1e-6)
