@@ -1,0 +1,103 @@
+"""Periodic orbits by Newton on a period map, and their Floquet multipliers (lib.orbits)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from lib import orbits, stability
+from lib.params import Body
+
+BODY = Body()
+
+
+def circle_map(k: int, eps: float = 0.1):
+    """x -> x + 2 pi / k + eps sin(k x), y -> y / 2 + sin(x) / 10: the points with sin(k x) = 0
+    are orbits of period k that advance by 2 pi per k steps (slipping), with multipliers
+    (1 + eps k cos(k x))^k along x and 2^-k along y."""
+    def step(x):
+        X, Y = x[:, 0], x[:, 1]
+        out = np.column_stack([X + 2 * np.pi / k + eps * np.sin(k * X), 0.5 * Y + 0.1 * np.sin(X)])
+        J = np.zeros((x.shape[0], 2, 2))
+        J[:, 0, 0] = 1 + eps * k * np.cos(k * X)
+        J[:, 1, 0] = 0.1 * np.cos(X)
+        J[:, 1, 1] = 0.5
+        return out, J
+    return step
+
+
+@pytest.mark.parametrize("k", [1, 3, 6])
+def test_newton_finds_known_orbits_of_period_1_3_and_6(k):
+    eps = 0.1
+    # the attracting orbit passes through x = pi / k (cos(k x) = -1); start 0.2 rad away
+    orb = orbits.newton_orbit(circle_map(k, eps), [[np.pi / k + 0.2, 0.3]], k, shift=[2 * np.pi, 0.0])
+    assert orb.converged[0] and orb.residual[0] < 1e-11
+    assert math.remainder(orb.x[0, 0] - np.pi / k, 2 * np.pi / k) == pytest.approx(0.0, abs=1e-10)
+    expected = sorted([abs(1 - eps * k) ** k, 0.5 ** k], reverse=True)
+    np.testing.assert_allclose(np.abs(orb.multipliers[0]), expected, rtol=1e-9)
+    assert orb.attracting[0]
+    # the repelling orbit through x = 0 is found too (from nearby: it repels by up to 17 per
+    # k steps, so a far start leaves the region where the map is nearly linear), and is not attracting
+    rep = orbits.newton_orbit(circle_map(k, eps), [[0.005, 0.0]], k, shift=[2 * np.pi, 0.0])
+    assert rep.converged[0] and abs(math.remainder(rep.x[0, 0], 2 * np.pi / k)) < 1e-10
+    assert abs(rep.multipliers[0, 0]) == pytest.approx((1 + eps * k) ** k, rel=1e-9)
+    assert not rep.attracting[0]
+
+
+def test_newton_finds_the_henon_fixed_point():
+    a, b = 1.4, 0.3
+
+    def henon(x):
+        X, Y = x[:, 0], x[:, 1]
+        J = np.zeros((x.shape[0], 2, 2))
+        J[:, 0, 0], J[:, 0, 1], J[:, 1, 0] = -2 * a * X, 1.0, b
+        return np.column_stack([1 - a * X**2 + Y, b * X]), J
+
+    xs = (-(1 - b) + math.sqrt((1 - b) ** 2 + 4 * a)) / (2 * a)
+    orb = orbits.newton_orbit(henon, [[0.5, 0.1]], 1)
+    np.testing.assert_allclose(orb.x[0], [xs, b * xs], atol=1e-12)
+    lam = np.linalg.eigvals(np.array([[-2 * a * xs, 1.0], [b, 0.0]]))
+    np.testing.assert_allclose(np.sort(np.abs(orb.multipliers[0])), np.sort(np.abs(lam)), rtol=1e-10)
+
+
+def test_rotation_period_map_jacobian_matches_finite_differences():
+    step = orbits.rotation_period_map(BODY, "eight", [2.0, 1.0], [math.pi / 4, 1.1], steps=256)
+    x = np.array([[2.5, -0.3], [3.0, 0.4]])
+    _, J = step(x)
+    h = 1e-6
+    fd = np.stack([(step(x + h * e)[0] - step(x - h * e)[0]) / (2 * h) for e in np.eye(2)], axis=-1)
+    np.testing.assert_allclose(J, fd, rtol=1e-6, atol=1e-7)
+
+
+def test_paper_eight_has_an_attracting_period_one_orbit_that_the_transient_reaches():
+    # the paper's eight (R = 2 m, Theta = pi/4): Newton from 10 periods of transient finds a
+    # period-1 orbit; its slowest multiplier is the rate at which the simulated transient
+    # from the reference start closes in on it, period after period
+    R, Th = 2.0, math.pi / 4
+    orb = orbits.rotation_orbit(BODY, "eight", [R], [Th])
+    assert orb.converged[0] and orb.attracting[0]
+    lam1 = abs(orb.multipliers[0, 0])
+    assert 0.9 < lam1 < 0.95
+    n = int(stability.steps_per_period(BODY, "eight", [R], [Th])[0])
+    t, p = stability.reduced_rotation(BODY, "eight", R, Th, 120, steps=n)
+    p_orbit = orb.x[0, 0] - stability._shape("eight")[0](0.0)[4]
+    gap = np.abs(p[::n] - p_orbit)                  # distance at t = jT from the orbit's point
+    assert gap[-1] < 1e-3 * gap[20]                 # the transient does reach this orbit
+    rate = (gap[100] / gap[60]) ** (1 / 40)
+    assert rate == pytest.approx(lam1, abs=2e-3)
+
+
+def test_bad_input_raises_clear_errors():
+    step = circle_map(1)
+    with pytest.raises(ValueError, match="period k"):
+        orbits.newton_orbit(step, [[0.0, 0.0]], 0)
+    with pytest.raises(ValueError, match="x0"):
+        orbits.newton_orbit(step, [[np.nan, 0.0]], 1)
+    with pytest.raises(ValueError, match="kind"):
+        orbits.rotation_period_map(BODY, "square", [1.0], [1.0])
+    with pytest.raises(ValueError, match="R"):
+        orbits.rotation_period_map(BODY, "eight", [-1.0], [1.0])
+    with pytest.raises(ValueError, match="shape"):
+        orbits.rotation_period_map(BODY, "eight", [1.0], [1.0], steps=64)(np.zeros((2, 2)))
+    with pytest.raises(ValueError, match="jacobian"):
+        orbits.floquet_multipliers(np.zeros(3))
