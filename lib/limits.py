@@ -504,8 +504,7 @@ def section_period(points, tol: float, max_period: int = 8) -> tuple[int, bool]:
     if not (np.isfinite(tol) and tol > 0):
         raise ValueError(f"tol must be a positive distance, got {tol!r}")
     for k in range(1, min(max_period, n // 2) + 1):
-        d = np.max(np.abs(pts[k:] - pts[:-k]), axis=1)
-        tail = d[len(d) // 2:]
+        tail = _lag_distances(pts, k)
         if np.all(tail[-k:] <= tol):
             return k, False
         if tail.size >= 8 and np.all(np.diff(tail) < 0) and _aitken_limit(tail) <= max(tol, 0.5 * tail[-1]):
@@ -525,11 +524,15 @@ def section_margin(points, tol: float, max_period: int = 8) -> float:
     if converging:
         return math.nan
     if k:
-        d = np.max(np.abs(pts[k:] - pts[:-k]), axis=1)
-        return float(tol / max(d[len(d) // 2:][-k:].max(), 1e-300))
+        return float(tol / max(_lag_distances(pts, k)[-k:].max(), 1e-300))
     lags = range(1, min(max_period, pts.shape[0] // 2) + 1)
-    return float(min(np.max(np.abs(pts[j:] - pts[:-j]), axis=1)[(pts.shape[0] - j) // 2:].min()
-                     for j in lags) / tol)
+    return float(min(_lag_distances(pts, j).min() for j in lags) / tol)
+
+
+def _lag_distances(pts: np.ndarray, k: int) -> np.ndarray:
+    """|P_(j+k) - P_j| (max-norm) over the second half of a section sequence."""
+    d = np.max(np.abs(pts[k:] - pts[:-k]), axis=1)
+    return d[len(d) // 2:]
 
 
 def _aitken_limit(d: np.ndarray) -> float:
