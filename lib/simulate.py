@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 from scipy.integrate import solve_ivp
 
-from .control import allocate, allocate_least_squares, computed_torque
+from .control import allocate, allocate_least_squares, allocate_limited, computed_torque
 from .model import config_accel
 from .params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from .trajectories import Reference
@@ -92,7 +92,7 @@ def _vector(name: str, value, default) -> np.ndarray:
     return arr
 
 
-ALLOCATIONS = ("position", "least_squares")
+ALLOCATIONS = ("position", "least_squares", "limited")
 
 
 def allocator(body: Body, allocation: str = "position", weights=(1.0, 1.0, 0.0), force_limit=None, angle_limit=None):
@@ -100,7 +100,9 @@ def allocator(body: Body, allocation: str = "position", weights=(1.0, 1.0, 0.0),
 
     ``"position"``: the paper's position-only law (25)-(26), :func:`lib.control.allocate`;
     ``"least_squares"``: the weighted law :func:`lib.control.allocate_least_squares`
-    with ``weights`` = (w_x, w_y, w_phi) (Chapter 6). Limits apply to both.
+    with ``weights`` = (w_x, w_y, w_phi) (Chapter 6), limits applied by projection;
+    ``"limited"``: the same weighted law solved exactly under the limits,
+    :func:`lib.control.allocate_limited`.
     """
     if allocation == "position":
         allocate(np.zeros(2), 0.0, force_limit, angle_limit)  # validate once
@@ -108,6 +110,9 @@ def allocator(body: Body, allocation: str = "position", weights=(1.0, 1.0, 0.0),
     if allocation == "least_squares":
         allocate_least_squares(np.zeros(3), 0.0, body, weights, force_limit, angle_limit)  # validate once
         return lambda tau, phi: allocate_least_squares(tau, phi, body, weights, force_limit, angle_limit)
+    if allocation == "limited":
+        allocate_limited(np.zeros(3), 0.0, body, weights, force_limit, angle_limit)  # validate once
+        return lambda tau, phi: allocate_limited(tau, phi, body, weights, force_limit, angle_limit)
     raise ValueError(f"unknown allocation {allocation!r}; known: {ALLOCATIONS}")
 
 
@@ -153,9 +158,11 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
     Filippov average angle and ``mode`` records the side.
 
     ``allocation`` selects the allocation step: ``"position"`` (default, the
-    paper's (25)-(26)) or ``"least_squares"`` (the weighted law of Chapter 6,
+    paper's (25)-(26)), ``"least_squares"`` (the weighted law of Chapter 6,
     :func:`lib.control.allocate_least_squares`, with ``weights`` =
-    (w_x, w_y, w_phi)); see :func:`allocator`. The event-located switching
+    (w_x, w_y, w_phi), limits by projection) or ``"limited"`` (the same law
+    solved exactly under the limits, :func:`lib.control.allocate_limited`); see
+    :func:`allocator`. The event-located switching
     supports the position-only law only.
     """
     if not isinstance(body, Body):

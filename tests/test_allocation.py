@@ -98,3 +98,76 @@ def test_per_demand_weights_equal_one_call_per_weight():
         np.testing.assert_allclose([F[i], beta[i]], [Fi, bi], rtol=1e-12, atol=1e-14)
     with pytest.raises(ValueError, match="not all zero"):
         control.allocate_least_squares(tau, phi, Body(), np.c_[W[:, :2], W[:, 2]] * [1, 1, 1] * (np.arange(5) != 2)[:, None])
+
+
+def _grid_min(tau, phi, body, W, fmax, bmax):
+    """Brute force: the least residual over a polar grid of the admissible sector."""
+    from lib.control import _least_squares
+
+    R, B = np.meshgrid(np.linspace(0.0, fmax, 201), np.linspace(-bmax, bmax, 541))
+    U = np.stack([R * np.cos(B), R * np.sin(B)], -1).reshape(-1, 2)
+    _, G, r, bb = _least_squares(tau, phi, body, W)
+    return (np.einsum("mi,nij,mj->nm", U, G, U) - 2 * r @ U.T + bb[:, None]).min(axis=1), (G, r, bb)
+
+
+@pytest.mark.parametrize("fmax, bmax", [(2.0, 0.4), (1.5, 1.2), (2.5, 2.2), (1.0, 3.0), (1.2, np.pi)])
+def test_limited_allocation_is_the_optimum_over_the_admissible_sector(fmax, bmax):
+    # random demands, headings and weights; beta_max > pi/2 makes the sector non-convex
+    from lib.control import allocate_limited, residual
+
+    rng = np.random.default_rng(7)
+    n = 400
+    tau = rng.normal(size=(n, 3)) * [3.0, 3.0, 1.0]
+    phi = rng.uniform(-np.pi, np.pi, n)
+    W = rng.uniform(0.0, 2.0, size=(n, 3)) + [0.1, 0.1, 0.0]
+    F, beta = allocate_limited(tau, phi, Body(), W, fmax, bmax)
+    assert np.all(F <= fmax * (1 + 1e-12)) and np.all(np.abs(beta) <= bmax + 1e-12)
+    J_grid, (G, r, bb) = _grid_min(tau, phi, Body(), W, fmax, bmax)
+    J = residual(np.stack([F * np.cos(beta), F * np.sin(beta)], -1), G, r, bb)
+    assert np.all(J <= J_grid + 1e-9 * (1 + np.abs(J_grid)))       # no admissible grid point does better
+    assert np.all(J_grid - J < 1e-3 * (1 + np.abs(J)))               # and the grid comes close to it
+
+
+def test_limited_allocation_beats_projection_and_reduces_without_limits():
+    from lib.control import _least_squares, allocate, allocate_least_squares, allocate_limited, residual
+
+    rng = np.random.default_rng(3)
+    tau, phi = rng.normal(size=(300, 3)) * [3.0, 3.0, 1.0], rng.uniform(-np.pi, np.pi, 300)
+    W = (1.0, 1.0, 0.5)
+    _, G, r, bb = _least_squares(tau, phi, Body(), W)
+
+    def J(F, beta):
+        return residual(np.stack([F * np.cos(beta), F * np.sin(beta)], -1), G, r, bb)
+
+    exact, proj = J(*allocate_limited(tau, phi, Body(), W, 2.0, 0.5)), \
+        J(*allocate_least_squares(tau, phi, Body(), W, 2.0, 0.5))
+    assert np.all(exact <= proj + 1e-9) and np.max(proj - exact) > 1.0   # projection is not the optimum
+    # no limit: the unconstrained optimum; and with w_phi = 0, exactly (25)-(26)
+    F, beta = allocate_limited(tau, phi, Body(), W)
+    Fu, bu = allocate_least_squares(tau, phi, Body(), W)
+    np.testing.assert_allclose(F, Fu, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(np.cos(beta - bu), 1.0, atol=1e-12)
+    F, beta = allocate_limited(tau, phi, Body(), (1.0, 1.0, 0.0))
+    F0, b0 = allocate(tau, phi)
+    np.testing.assert_allclose(F, F0, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(np.cos(beta - b0), 1.0, atol=1e-12)
+
+
+@pytest.mark.parametrize("kw, msg", [({"force_limit": -1.0}, "force_limit"), ({"angle_limit": 4.0}, "angle_limit"),
+                                     ({"weights": (0.0, 0.0, 0.0)}, "weights")])
+def test_limited_allocation_rejects_bad_input(kw, msg):
+    from lib.control import allocate_limited
+
+    with pytest.raises(ValueError, match=msg):
+        allocate_limited(np.ones(3), 0.0, Body(), **{"weights": (1.0, 1.0, 0.0), **kw})
+
+
+def test_simulate_runs_the_exact_limited_allocation_within_its_limits():
+    from lib import trajectories
+    from lib.params import Gains
+    from lib.simulate import simulate
+
+    res = simulate(Body(), Gains(), trajectories.eight(), 16.0, force_limit=4.0, angle_limit=1.0,
+                   allocation="limited", weights=(1.0, 1.0, 0.1), rtol=1e-8, atol=1e-8)
+    assert res.F.max() <= 4.0 + 1e-12 and np.abs(res.beta).max() <= 1.0 + 1e-12
+    assert np.isclose(res.F.max(), 4.0)                      # the cap binds on this run
