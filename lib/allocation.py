@@ -1,213 +1,314 @@
-"""Chapter 6: the closed loop with the weighted least-squares allocation, run for
-many parameter points at once.
+"""The allocation step: which force F (N) at which angle beta (rad) realises a demanded
+generalized force tau = [tau_x (N), tau_y (N), tau_phi (N m)] (paper Sec. 4).
 
-The position-only law (25)-(26) leaves the heading to itself; the weighted
-allocation :func:`lib.control.allocate_least_squares` trades position tracking
-for heading tracking through the weight w_phi. To map that trade-off over the
-(R, Theta) plane of Fig. 5 the closed loop (2)-(4), (23) is integrated for all
-points together with the classical fixed-step Runge-Kutta scheme of order 4,
-vectorised over points (each point may have its own R, Theta and weights). The
-step is chosen small against the fastest closed-loop time scale; the tests
-check the result against the adaptive, tight-tolerance :func:`lib.simulate.simulate`.
+* :func:`allocate`: the paper's position-only law (25)-(26), which realises
+  (tau_x, tau_y) exactly and leaves tau_phi to itself;
+* :func:`allocate_least_squares`: the weighted least-squares problem the paper
+  poses after (24) and leaves open, in closed form (Chapter 6);
+* :func:`allocate_limited`: the same problem solved exactly under force and angle limits.
+
+The limits of the paper's Sec. 5, F <= F_max (29) and |beta| <= beta_max (30), are a
+:class:`Limits` object. The public functions validate their arguments at every call;
+loops (the integrators) bind an :class:`Allocation` to a body and limits once with
+:meth:`Allocation.bind` and call the unvalidated kernel it returns.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
-import pandas as pd
 
-from .control import allocate_least_squares, computed_torque_from, wrap_angle
-from .model import config_accel
-from .params import Body, Gains
-from .robustness import perturbed
-from .stability import eight_rotation_sweep
-from .trajectories import KINEMATICS
+from .angles import wrap_angle
+from .model import input_matrix
+from .params import Body
 
-__all__ = ["BatchResult", "closed_loop_batch", "steady_metrics", "MapComparison", "compare_on_map"]
+__all__ = ["Limits", "Allocation", "LAWS", "allocate", "allocate_least_squares", "allocate_limited", "residual",
+           "least_squares_problem"]
+
+
+def _check_limit(name: str, value, upper: float) -> float:
+    if isinstance(value, bool) or not np.isscalar(value) or not np.isfinite(value) or not 0 < value <= upper:
+        raise ValueError(f"{name} must be a finite number in (0, {upper}], got {value!r}")
+    return float(value)
 
 
 @dataclass(frozen=True)
-class BatchResult:
-    """Samples of N closed-loop runs: ``t`` (n,), ``z``/``dz``/``z_d`` (n, N, 3), ``F`` (n, N) in N.
+class Limits:
+    """Force and angle limits of the paper's Sec. 5: F <= ``force`` (N, eq. (29)) and
+    |beta| <= ``angle`` (rad, in (0, pi], eq. (30)); None means no limit. Validated
+    on construction."""
 
-    ``period`` (N,) is the reference period 2 pi / |Theta| of each point (s).
+    force: float | None = None
+    angle: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.force is not None:
+            object.__setattr__(self, "force", _check_limit("force_limit", self.force, upper=np.inf))
+        if self.angle is not None:
+            object.__setattr__(self, "angle", _check_limit("angle_limit", self.angle, upper=np.pi))
+
+    def apply(self, F, beta):
+        """Cap F at ``force`` (the direction kept) and clip beta to [-angle, angle]:
+        the projection of the paper's Sec. 5."""
+        if self.force is not None:
+            F = np.minimum(F, self.force)
+        if self.angle is not None:
+            beta = np.clip(beta, -self.angle, self.angle)
+        return F, beta
+
+
+def allocate(tau, phi, force_limit: float | None = None, angle_limit: float | None = None):
+    """Force magnitude and angle realising (tau_x, tau_y), eqs. (25)-(26).
+
+    F = sqrt(tau_x^2 + tau_y^2) (N) and beta = Arg(tau_x + i tau_y) - phi (rad),
+    wrapped to (-pi, pi]; tau_phi (``tau[..., 2]``, if present) is ignored.
+
+    Limits, applied when given:
+
+    * ``force_limit`` (N, > 0): F is capped, F <- min(F, force_limit), the
+      direction kept;
+    * ``angle_limit`` (rad, in (0, pi]): beta is clipped to
+      [-angle_limit, angle_limit]. A demanded direction behind the body
+      (|beta| > angle_limit) is replaced by the nearest admissible direction,
+      so beta jumps from +angle_limit to -angle_limit when the demand passes
+      straight behind the body.
+
+    When tau_x = tau_y = 0 no force is needed: F = 0 and beta = 0 by
+    definition (the direction of a zero force is immaterial).
+
+    Returns (F, beta) as arrays of the broadcast shape of tau[..., 0] and phi.
     """
-
-    t: np.ndarray
-    z: np.ndarray
-    dz: np.ndarray
-    z_d: np.ndarray
-    F: np.ndarray
-    period: np.ndarray
-
-    @property
-    def rotation_error(self) -> np.ndarray:
-        """p = phi - phi_d (rad), shape (n, N)."""
-        return self.z[..., 2] - self.z_d[..., 2]
-
-    @property
-    def position_error(self) -> np.ndarray:
-        """Distance |(x, y) - (x_d, y_d)| (m), shape (n, N)."""
-        return np.hypot(*np.moveaxis(self.z[..., :2] - self.z_d[..., :2], -1, 0))
+    return _position(_check_tau(tau, (2, 3)), phi, Limits(force_limit, angle_limit))
 
 
-def _points(R, Theta, weights):
-    R = np.atleast_1d(np.asarray(R, dtype=float))
-    Theta = np.atleast_1d(np.asarray(Theta, dtype=float))
+def _position(tau, phi, limits: Limits):
+    """The unvalidated kernel of :func:`allocate`, for loops."""
+    tx, ty = tau[..., 0], tau[..., 1]
+    F = np.hypot(tx, ty)
+    beta = np.where(F > 0, wrap_angle(np.arctan2(ty, tx) - np.asarray(phi, dtype=float)), 0.0)
+    F = np.broadcast_to(F, beta.shape).copy()
+    return limits.apply(F, beta)
+
+
+def _check_weights(weights) -> np.ndarray:
     w = np.asarray(weights, dtype=float)
-    if w.ndim == 1:
-        w = np.broadcast_to(w, (max(R.size, Theta.size), 3))
-    if R.ndim != 1 or Theta.ndim != 1 or w.ndim != 2 or w.shape[1] != 3:
-        raise ValueError("R and Theta must be 1-D arrays and weights (3,) or (N, 3)")
-    if R.size == 0 or Theta.size == 0 or w.shape[0] == 0:
-        raise ValueError("no parameter points given (empty arrays)")
-    n = max(R.size, Theta.size, w.shape[0])
-    try:
-        R, Theta, w = np.broadcast_to(R, n), np.broadcast_to(Theta, n), np.broadcast_to(w, (n, 3))
-    except ValueError:
-        raise ValueError(f"R ({R.size}), Theta ({Theta.size}) and weights ({w.shape[0]}) must have equal "
-                         "lengths (or length 1)") from None
-    if not (np.all(np.isfinite(R)) and np.all(R > 0)):
-        raise ValueError("every R must be a positive finite radius (m)")
-    if not (np.all(np.isfinite(Theta)) and np.all(Theta != 0)):
-        raise ValueError("every Theta must be finite and non-zero (rad/s)")
-    return R, Theta, w
+    if w.ndim == 0 or w.shape[-1] != 3 or not np.all(np.isfinite(w)) or np.any(w < 0) or not np.all(np.any(w > 0, -1)):
+        raise ValueError(f"weights must be three finite non-negative numbers, not all zero, got {weights!r}")
+    return w
 
 
-def closed_loop_batch(body: Body, gains: Gains, kind: str, R, Theta, weights=(1.0, 1.0, 0.0), *,
-                      t_end: float, dt: float = 0.01, record_dt: float = 0.05,
-                      z0=None, dz0=None) -> BatchResult:
-    """Integrate the closed loop with the weighted allocation for N points at once.
+def _check_tau(tau, n=(3,)) -> np.ndarray:
+    tau = np.asarray(tau, dtype=float)
+    if tau.ndim == 0 or tau.shape[-1] not in n:
+        names = "3 (tau_x, tau_y, tau_phi)" if n == (3,) else "2 or 3"
+        raise ValueError(f"tau must have a last axis of length {names}, got shape {tau.shape}")
+    return tau
 
-    ``kind`` is ``"circle"`` or ``"eight"``; ``R`` (m), ``Theta`` (rad/s) and
-    ``weights`` (w_x, w_y, w_phi) are per point (arrays of length N, or one
-    value for all). The runs start on the reference (z = z_d(0), dz = dz_d(0))
-    unless ``z0``/``dz0`` (shape (3,) or (N, 3)) are given. Classical RK4 with
-    step ``dt`` (s) from 0 to ``t_end`` (s); samples every ``record_dt`` (s).
-    A run that becomes non-finite raises ``FloatingPointError`` naming the point.
+
+def _checked_body(body) -> Body:
+    if not isinstance(body, Body):
+        raise TypeError(f"body must be a lib.params.Body, got {type(body).__name__}")
+    return body
+
+
+def least_squares_problem(tau, phi, body: Body, weights):
+    """The weighted least-squares problem of :func:`allocate_least_squares`, validated;
+    see :func:`_ls_kernel`."""
+    tau = _check_tau(tau)
+    w = _check_weights(weights)
+    return _ls_kernel(tau, phi, _checked_body(body), np.sqrt(w))
+
+
+def _ls_kernel(tau, phi, body: Body, sw):
+    """The unvalidated kernel of the weighted least-squares allocation, for loops:
+    returns its unconstrained solution u* (..., 2), and G = A^T A (..., 2, 2),
+    r = A^T b (..., 2) and |b|^2 (...), so that the residual is
+    J(u) = u^T G u - 2 r^T u + |b|^2, with A = W^(1/2) B(phi) and b = W^(1/2) tau
+    (``sw`` = W^(1/2), the square roots of the weights)."""
+    A = sw[..., :, None] * input_matrix(phi, body)             # (..., 3, 2)
+    A = np.broadcast_to(A, np.broadcast_shapes(A.shape, tau.shape[:-1] + (3, 2)))
+    b = sw * tau                                               # (..., 3)
+    # normal equations G u = r with G = A^T A (2 x 2), solved in closed form;
+    # where G is (nearly) singular, the pseudo-inverse gives the minimum-norm u
+    G = np.einsum("...ki,...kj->...ij", A, A)
+    r = np.einsum("...ki,...k->...i", A, b)
+    det = G[..., 0, 0] * G[..., 1, 1] - G[..., 0, 1] * G[..., 1, 0]
+    regular = det > 1e-12 * np.maximum(G[..., 0, 0] + G[..., 1, 1], 1e-300) ** 2
+    safe = np.where(regular, det, 1.0)
+    u = np.stack([(G[..., 1, 1] * r[..., 0] - G[..., 0, 1] * r[..., 1]) / safe,
+                  (G[..., 0, 0] * r[..., 1] - G[..., 1, 0] * r[..., 0]) / safe], axis=-1)
+    if not np.all(regular):
+        u = np.where(regular[..., None], u, (np.linalg.pinv(A) @ b[..., None])[..., 0])
+    return u, G, r, np.einsum("...k,...k->...", b, b)
+
+
+def residual(u, G, r, bb) -> np.ndarray:
+    """J(u) = u^T G u - 2 r^T u + |b|^2 of :func:`least_squares_problem`, for u of shape (..., 2)."""
+    return np.einsum("...i,...ij,...j->...", u, G, u) - 2 * np.einsum("...i,...i->...", r, u) + bb
+
+
+def allocate_limited(tau, phi, body: Body, weights=(1.0, 1.0, 0.0),
+                     force_limit: float | None = None, angle_limit: float | None = None):
+    """The weighted least-squares allocation *under* the limits, solved exactly.
+
+    Minimises J(u) = sum_i w_i (tau_i - Q_i(u))^2 (see :func:`allocate_least_squares`)
+    over the admissible forces u = (F cos beta, F sin beta) with F <= ``force_limit``
+    (N) and |beta| <= ``angle_limit`` (rad): a disc sector, convex for
+    angle_limit <= pi/2 and not for larger limits. J is a convex quadratic, so its
+    minimum over the sector is the unconstrained optimum when that is admissible,
+    and otherwise lies on the boundary: on one of the two rays beta = +-angle_limit
+    (a quadratic in F, minimised in closed form and clipped to [0, force_limit]), or
+    on the arc F = force_limit (a trigonometric polynomial of degree 2 in beta,
+    minimised by sampling it at 129 angles and refining each sampled local minimum
+    by golden-section search to machine precision). The candidate with the least J
+    is returned; this holds for the non-convex sector too, since it only uses that
+    an interior minimum of a convex function is unconstrained.
+
+    With no limit it is :func:`allocate_least_squares`; with w_phi = 0 and no limit,
+    exactly (25)-(26). Returns (F (N), beta (rad)) like :func:`allocate`.
     """
-    if kind not in KINEMATICS:
-        raise ValueError(f"unknown trajectory {kind!r}; known: {sorted(KINEMATICS)}")
-    if not isinstance(body, Body) or not isinstance(gains, Gains):
-        raise TypeError("body must be a lib.params.Body and gains a lib.params.Gains")
-    for name, v in (("t_end", t_end), ("dt", dt), ("record_dt", record_dt)):
-        if not np.isfinite(v) or v <= 0:
-            raise ValueError(f"{name} must be a positive finite time (s), got {v!r}")
-    R, Theta, w = _points(R, Theta, weights)
-    kin = KINEMATICS[kind]
-
-    def rhs(t, s):
-        z, dz = s[:, :3], s[:, 3:]
-        zd, dzd, ddzd = kin(R, Theta, t)
-        tau = computed_torque_from(body, gains, zd, dzd, ddzd, z, dz)
-        F, beta = allocate_least_squares(tau, z[:, 2], body, w)
-        return np.concatenate([dz, config_accel(body, z, dz, F, beta)], axis=1), F
-
-    zd0, dzd0, _ = kin(R, Theta, 0.0)
-    z0 = zd0 if z0 is None else np.broadcast_to(np.asarray(z0, dtype=float), zd0.shape)
-    dz0 = dzd0 if dz0 is None else np.broadcast_to(np.asarray(dz0, dtype=float), dzd0.shape)
-    s = np.concatenate([z0, dz0], axis=1)
-    n_steps = int(np.ceil(t_end / dt))
-    h = t_end / n_steps
-    every = max(1, int(round(record_dt / h)))
-    ts, states, forces = [], [], []
-    t = 0.0
-    for k in range(n_steps + 1):
-        k1, F = rhs(t, s)
-        if k % every == 0 or k == n_steps:
-            ts.append(t)
-            states.append(s.copy())
-            forces.append(F)
-        if k == n_steps:
-            break
-        k2, _ = rhs(t + h / 2, s + h / 2 * k1)
-        k3, _ = rhs(t + h / 2, s + h / 2 * k2)
-        k4, _ = rhs(t + h, s + h * k3)
-        s = s + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-        t = (k + 1) * h
-        if not np.all(np.isfinite(s)):
-            bad = int(np.flatnonzero(~np.all(np.isfinite(s), axis=1))[0])
-            raise FloatingPointError(f"closed loop became non-finite at t = {t:.6g} s for point {bad} "
-                                     f"(R = {R[bad]:g} m, Theta = {Theta[bad]:g} rad/s, weights = {w[bad]})")
-    t = np.array(ts)
-    S = np.array(states)
-    return BatchResult(t=t, z=S[..., :3], dz=S[..., 3:], z_d=kin(R[None, :], Theta[None, :], t[:, None])[0],
-                       F=np.array(forces), period=2 * np.pi / np.abs(Theta))
+    limits = Limits(force_limit, angle_limit)
+    return _limited(_check_tau(tau), phi, _checked_body(body), np.sqrt(_check_weights(weights)), limits)
 
 
-def steady_metrics(res: BatchResult, n_periods: float = 2.0) -> pd.DataFrame:
-    """Steady-state measures of each run over its last ``n_periods`` reference periods.
+def _limited(tau, phi, body: Body, sw, limits: Limits):
+    """The unvalidated kernel of :func:`allocate_limited`, for loops (``sw`` the square
+    roots of the weights)."""
+    u_star, G, r, bb = _ls_kernel(tau, phi, body, sw)
+    fmax = np.inf if limits.force is None else limits.force
+    bmax = np.pi if limits.angle is None else limits.angle
+    shape = np.broadcast_shapes(u_star.shape[:-1], G.shape[:-2], r.shape[:-1], bb.shape)
+    u_star = np.broadcast_to(u_star, shape + (2,)).reshape(-1, 2)
+    G = np.broadcast_to(G, shape + (2, 2)).reshape(-1, 2, 2)
+    r = np.broadcast_to(r, shape + (2,)).reshape(-1, 2)
+    bb = np.broadcast_to(bb, shape).reshape(-1)
+    F_star = np.hypot(u_star[:, 0], u_star[:, 1])
+    admissible = (F_star <= fmax) & ((F_star == 0) | (np.abs(np.arctan2(u_star[:, 1], u_star[:, 0])) <= bmax))
+    cands = [np.where(admissible[:, None], u_star, np.nan),  # the unconstrained optimum, if admissible
+             np.zeros_like(u_star)]                           # the corner at the origin
+    if bmax < np.pi:                                          # the two rays beta = +-bmax
+        for sign in (1.0, -1.0):
+            d = np.array([np.cos(bmax), sign * np.sin(bmax)])
+            dGd = np.einsum("i,nij,j->n", d, G, d)
+            rd = r @ d
+            # J(t d) = t^2 dGd - 2 t rd + |b|^2; dGd = 0 forces rd = 0 (J >= 0), so J is flat there
+            t = np.divide(rd, dGd, out=np.zeros_like(rd), where=dGd > 0)
+            cands.append(np.clip(t, 0.0, fmax)[:, None] * d)
+    if np.isfinite(fmax):                                     # the arc F = fmax
+        cands += _arc_minima(G, r, fmax, bmax)
+    C = np.stack(cands, axis=1)                               # (n, candidates, 2)
+    J = np.nan_to_num(residual(C, G[:, None], r[:, None], bb[:, None]), nan=np.inf)
+    u = C[np.arange(C.shape[0]), np.argmin(J, axis=1)]
+    F = np.hypot(u[:, 0], u[:, 1])
+    beta = np.where(F > 0, np.arctan2(u[:, 1], u[:, 0]), 0.0)
+    return F.reshape(shape), beta.reshape(shape)
 
-    Columns: ``pos_rms`` and ``pos_max`` (m) of the position error; ``p_range``
-    (rad) max - min of the rotation error p; ``p_rms`` (rad) its RMS after
-    wrapping to (-pi, pi] (how far the heading is from the tangent); ``slip_per_period`` (turns) the
-    net change of p over the last period divided by 2 pi; ``heading_held``
-    True when that net change is below half a turn (the heading does not keep
-    slipping); ``pos_drift`` (m) the mean position error over the last period
-    minus that over the period before, and ``position_held`` True when it is
-    below 1 mm (the body does not drift away from the path); ``F_max`` and
-    ``F_rms`` (N).
-    """
+
+def _arc_minima(G, r, fmax: float, bmax: float, n_samples: int = 129) -> list[np.ndarray]:
+    """Points u = fmax (cos beta, sin beta), |beta| <= bmax, at the two best sampled local
+    minima of J along the arc, each refined by golden-section search between its neighbours
+    (J along the arc is a trigonometric polynomial of degree 2: at most two local minima)."""
+    def J_arc(beta):  # J - |b|^2 at u = fmax e(beta), for beta of shape (n,)
+        e = np.stack([np.cos(beta), np.sin(beta)], axis=-1) * fmax
+        return np.einsum("ni,nij,nj->n", e, G, e) - 2 * np.einsum("ni,ni->n", r, e)
+
+    betas = np.linspace(-bmax, bmax, n_samples)
+    E = np.stack([np.cos(betas), np.sin(betas)], axis=-1) * fmax
+    J = np.einsum("mi,nij,mj->nm", E, G, E) - 2 * r @ E.T                   # (n, samples)
+    Jp = np.pad(J, ((0, 0), (1, 1)), constant_values=np.inf)
+    local = (J <= Jp[:, :-2]) & (J <= Jp[:, 2:])
+    ranked = np.argsort(np.where(local, J, np.inf), axis=1, kind="stable")[:, :2]
+    h, g = betas[1] - betas[0], (np.sqrt(5.0) - 1) / 2
     out = []
-    p, e, F = res.rotation_error, res.position_error, res.F
-    for j, P in enumerate(res.period):
-        last = res.t >= res.t[-1] - n_periods * P
-        if res.t[-1] < (n_periods + 1) * P:
-            raise ValueError(f"run {j} is shorter than {n_periods + 1:g} reference periods; extend t_end")
-        one = res.t >= res.t[-1] - P
-        before = (res.t >= res.t[-1] - 2 * P) & ~one
-        net = p[-1, j] - p[one, j][0]
-        drift = float(e[one, j].mean() - e[before, j].mean())
-        p_wrapped = wrap_angle(p[last, j])
-        out.append(dict(pos_rms=float(np.sqrt(np.mean(e[last, j] ** 2))), pos_max=float(e[last, j].max()),
-                        p_range=float(np.ptp(p[last, j])), p_rms=float(np.sqrt(np.mean(p_wrapped ** 2))), slip_per_period=float(net / (2 * np.pi)),
-                        heading_held=bool(abs(net) < np.pi), pos_drift=drift,
-                        position_held=bool(drift < 1e-3), F_max=float(F[last, j].max()),
-                        F_rms=float(np.sqrt(np.mean(F[last, j] ** 2)))))
-    return pd.DataFrame(out)
+    for j in range(ranked.shape[1]):
+        c = betas[ranked[:, j]]
+        lo, hi = np.maximum(c - h, -bmax), np.minimum(c + h, bmax)
+        for _ in range(60):  # the bracket shrinks by 0.618 per step: 60 steps reach rounding
+            x1, x2 = hi - g * (hi - lo), lo + g * (hi - lo)
+            left = J_arc(x1) < J_arc(x2)
+            lo, hi = np.where(left, lo, x1), np.where(left, x2, hi)
+        best = 0.5 * (lo + hi)
+        out.append(np.stack([np.cos(best), np.sin(best)], axis=-1) * fmax)
+    return out
+
+
+def allocate_least_squares(tau, phi, body: Body, weights=(1.0, 1.0, 0.0),
+                           force_limit: float | None = None, angle_limit: float | None = None):
+    """Force and angle minimising the weighted residual of the whole demand (23).
+
+    Solves min_u sum_i w_i (tau_i - Q_i(u))^2 with Q = B(phi) u (see
+    :func:`input_matrix`), u = (F cos beta, F sin beta): the optimisation the
+    paper poses after eq. (24) and leaves unsolved. Q is linear in u, so this
+    is linear least squares with the closed form
+
+        u* = (W^(1/2) B)^+ W^(1/2) tau,
+
+    the minimum-norm solution when B^T W B is singular (e.g. w_x = w_y = 0).
+    For w_x = w_y = w it reduces to
+    u1 = cos(phi) tau_x + sin(phi) tau_y and
+    u2 = [w (-sin(phi) tau_x + cos(phi) tau_y) + a w_phi tau_phi] / (w + a^2 w_phi);
+    with w_phi = 0 it is exactly the position-only law (25)-(26).
+
+    ``weights`` = (w_x, w_y, w_phi) >= 0, not all zero (units: w_phi weighs a
+    torque residual in (N m)^2 against force residuals in N^2); an array of
+    shape (..., 3) gives one weight triple per demand. Limits are then
+    applied as in :func:`allocate` (cap on F, clip of beta): a projection of the
+    unconstrained optimum, not the optimum under the limits.
+
+    Returns (F (N), beta (rad)), beta in (-pi, pi]; F = 0, beta = 0 when u* = 0.
+    """
+    limits = Limits(force_limit, angle_limit)
+    return _weighted(_check_tau(tau), phi, _checked_body(body), np.sqrt(_check_weights(weights)), limits)
+
+
+def _weighted(tau, phi, body: Body, sw, limits: Limits):
+    """The unvalidated kernel of :func:`allocate_least_squares`, for loops."""
+    u, _, _, _ = _ls_kernel(tau, phi, body, sw)
+    F = np.hypot(u[..., 0], u[..., 1])
+    beta = np.where(F > 0, np.arctan2(u[..., 1], u[..., 0]), 0.0)
+    return limits.apply(F, beta)
+
+
+
+
+Allocator = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
+
+#: the allocation laws :class:`Allocation` knows
+LAWS = ("position", "least_squares", "limited")
 
 
 @dataclass(frozen=True)
-class MapComparison:
-    """The two laws on a set of (R, Theta) points of the eight, from one start.
+class Allocation:
+    """Which allocation law the closed loop uses, validated on construction.
 
-    ``lost`` (N,) bool: the paper's law does not settle to a periodic heading
-    (Chapter 5's classification, :func:`lib.stability.eight_rotation_sweep`);
-    ``held`` (N,) bool: under the weighted law the heading does not slip over the
-    last period and the body stays on the path (:func:`steady_metrics`);
-    ``pos_rms`` (N,) the weighted law's steady position error (m RMS).
+    ``law``: ``"position"`` (the paper's (25)-(26), :func:`allocate`, the default),
+    ``"least_squares"`` (:func:`allocate_least_squares` with ``weights`` =
+    (w_x, w_y, w_phi), limits by projection) or ``"limited"``
+    (:func:`allocate_limited`, the same law solved exactly under the limits).
+    ``weights`` may be (3,) or, for a batch of points, (N, 3).
     """
 
-    lost: np.ndarray
-    held: np.ndarray
-    pos_rms: np.ndarray
+    law: str = "position"
+    weights: tuple | np.ndarray = (1.0, 1.0, 0.0)
 
-    @property
-    def counts(self) -> dict:
-        """Points lost under the paper's law, of those held by the weighted law
-        ("rescued"), and periodic under the paper's law but not held ("broken")."""
-        return {"lost": int(self.lost.sum()), "rescued": int((self.lost & self.held).sum()),
-                "broken": int((~self.lost & ~self.held).sum())}
+    def __post_init__(self) -> None:
+        if self.law not in LAWS:
+            raise ValueError(f"unknown allocation {self.law!r}; known: {LAWS}")
+        w = _check_weights(self.weights)
+        w.setflags(write=False)
+        object.__setattr__(self, "weights", w)
 
-
-def compare_on_map(body: Body, gains: Gains, R, Theta, w_phi: float, *, t_end: float, dt: float = 0.02,
-                   rel: float = 0.0) -> MapComparison:
-    """Classify the paper's law and the weighted law (weights (1, 1, ``w_phi``)) on the eight
-    at the points (R_i (m), Theta_i (rad/s)), both started on the reference; with ``rel``
-    != 0 both starts are moved by :func:`lib.robustness.perturbed` (the heading error of
-    the paper's law by ``rel`` rad and ``rel`` rad/s), to show which verdicts ride on
-    the last bits of a chaotic motion. The weighted law runs for ``t_end`` (s) with
-    RK4 step ``dt`` (s)."""
-    R, Theta, _ = _points(R, Theta, (1.0, 1.0, w_phi))
-    dp0, dv0 = perturbed(np.zeros(2), rel)
-    paper = eight_rotation_sweep(body, R, Theta, p0=dp0, v0=dv0)
-    zd0, dzd0, _ = KINEMATICS["eight"](R, Theta, 0.0)
-    s0 = perturbed(np.concatenate([zd0, dzd0], axis=1), rel)
-    res = closed_loop_batch(body, gains, "eight", R, Theta, (1.0, 1.0, w_phi), t_end=t_end, dt=dt,
-                            record_dt=0.05, z0=s0[:, :3], dz0=s0[:, 3:])
-    m = steady_metrics(res)
-    return MapComparison(lost=paper.regime.to_numpy() != "periodic",
-                         held=m.heading_held.to_numpy() & m.position_held.to_numpy(),
-                         pos_rms=m.pos_rms.to_numpy())
+    def bind(self, body: Body, limits: Limits | None = None) -> Allocator:
+        """The allocation step (tau, phi) -> (F (N), beta (rad)) for ``body`` under
+        ``limits``, validated here once; the returned function checks nothing."""
+        _checked_body(body)
+        limits = Limits() if limits is None else limits
+        if not isinstance(limits, Limits):
+            raise TypeError(f"limits must be a lib.allocation.Limits, got {type(limits).__name__}")
+        if self.law == "position":
+            return lambda tau, phi: _position(tau, phi, limits)
+        sw = np.sqrt(self.weights)
+        kernel = _weighted if self.law == "least_squares" else _limited
+        return lambda tau, phi: kernel(tau, phi, body, sw, limits)

@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import numbers
+from collections.abc import Mapping
+from dataclasses import fields, is_dataclass
 
 import numpy as np
 
-__all__ = ["glue"]
+__all__ = ["glue", "glue_all", "markdown_table"]
 
 
 def glue(name: str, value, display: bool = False) -> None:
@@ -23,6 +25,20 @@ def glue(name: str, value, display: bool = False) -> None:
     if isinstance(value, numbers.Real) and not isinstance(value, bool) and not np.isfinite(value):
         raise ValueError(f"refusing to glue non-finite value {value!r} as {name!r}")
     _glue(name, value, display=display)
+
+
+def glue_all(values, prefix: str = "") -> None:
+    """Glue every entry of ``values`` as ``prefix + key``: a mapping, or an object with
+    fields (a dataclass, a :class:`typing.NamedTuple`). Lets a chapter glue the result
+    object of a claim in one call, e.g. ``glue_all(summary, "cap_")``."""
+    if is_dataclass(values) and not isinstance(values, type):
+        values = {f.name: getattr(values, f.name) for f in fields(values)}
+    elif hasattr(values, "_asdict"):
+        values = values._asdict()
+    if not isinstance(values, Mapping):
+        raise TypeError(f"glue_all needs a mapping or a dataclass, got {type(values).__name__}")
+    for key, value in values.items():
+        glue(f"{prefix}{key}", value)
 
 
 def markdown_table(frame, index: bool = False):

@@ -24,8 +24,12 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
+from scipy.optimize import brentq
+
+from . import model
 from .params import Body
-from .symbolic import Bracket, bracket_degree, bracket_latex, evaluate_bracket
+from .symbolic import (Bracket, accessibility_matrix, bracket_degree, bracket_latex, derive_body_frame,
+                       evaluate_bracket, model_fields)
 
 __all__ = [
     "right_nested", "paper_bracket_count", "witt_dimension", "free_lie_rank",
@@ -211,7 +215,6 @@ def full_rank_brackets() -> list[Bracket]:
 
 def strong_accessibility_det() -> sp.Expr:
     """det of :func:`full_rank_brackets` for the derived model, factored (symbolic parameters)."""
-    from .symbolic import accessibility_matrix, derive_body_frame, model_fields
 
     model = derive_body_frame()
     det = accessibility_matrix(model_fields(model), full_rank_brackets(), model.q).det()
@@ -222,7 +225,6 @@ def strong_accessibility_det() -> sp.Expr:
 def rest_report(max_order: int = 3) -> SussmannReport:
     """:func:`sussmann_check` for the derived model at a rest state (v1 = v2 = omega = 0,
     any x, y, phi), with symbolic parameters, brackets up to ``max_order``."""
-    from .symbolic import derive_body_frame, model_fields
 
     model = derive_body_frame()
     _, _, _, V1, V2, W = model.q
@@ -238,7 +240,6 @@ def rest_time_bound(body: Body, omega0: float, u_max: float) -> float:
     reachable state has phi on the side of phi0 that omega0 points to, so the
     start is not an interior point of the reachable set: no STLC there.
     """
-    from scipy.optimize import brentq
 
     if not np.isfinite(omega0) or omega0 == 0.0:
         raise ValueError(f"omega0 must be finite and nonzero, got {omega0}")
@@ -296,8 +297,6 @@ def numeric_bracket(expr: Bracket, fields: Mapping[str, Field], q, h: float = 1e
 def numeric_fields(body: Body, *, printed: bool = False) -> dict[str, Field]:
     """The numpy fields of :mod:`lib.model` ({"f", "g1", "g2"}) for ``body``;
     ``printed=True`` uses the printed drift (6)."""
-    from . import model
-
     drift = model.f_printed if printed else model.f
     return {"f": lambda q: drift(body, q), "g1": lambda q: model.g1(body),
             "g2": lambda q: model.g2(body)}

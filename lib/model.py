@@ -14,7 +14,7 @@ import numpy as np
 from .params import Body
 
 __all__ = [
-    "config_accel", "generalized_force", "f", "f_printed", "g1", "g2", "state_rhs",
+    "config_accel", "generalized_force", "input_matrix", "f", "f_printed", "g1", "g2", "state_rhs",
     "state_from_config", "config_from_state",
 ]
 
@@ -33,6 +33,17 @@ def generalized_force(F, beta, phi) -> np.ndarray:
     """
     F, beta, phi = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (F, beta, phi)))
     return np.stack([F * np.cos(phi + beta), F * np.sin(phi + beta), F * np.sin(beta)], axis=-1)
+
+
+def input_matrix(phi, body: Body) -> np.ndarray:
+    """B(phi) with Q = B(phi) u, u = (u1, u2) = (F cos beta, F sin beta), eq. (22).
+
+    B = [[cos phi, -sin phi], [sin phi, cos phi], [0, a]]; shape phi.shape + (3, 2).
+    """
+    phi = np.asarray(phi, dtype=float)
+    c, s = np.cos(phi), np.sin(phi)
+    z, a = np.zeros_like(phi), np.full_like(phi, body.a)
+    return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1), np.stack([z, a], -1)], -2)
 
 
 def config_accel(body: Body, z, dz, F, beta) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""Matplotlib helpers. Each takes an optional ``ax`` and returns the figure,
+"""The book's figures (Matplotlib). Each takes an optional ``ax`` and returns the figure,
 so notebooks can compose them."""
 
 from __future__ import annotations
@@ -7,9 +7,13 @@ import numpy as np
 import matplotlib.pyplot as plt
 from matplotlib.patches import FancyArrowPatch, Polygon
 
+import pandas as pd
+
+from .circle_rotation import circle_critical_radius
 from .params import Body
 
-__all__ = ["body_outline", "draw_body", "new_axes"]
+__all__ = ["body_outline", "draw_body", "new_axes", "plot_path", "plot_errors", "plot_force", "plot_bifurcation",
+           "plot_section", "plot_fig5", "plot_circle_map"]
 
 
 def new_axes(ax=None, **subplot_kw):
@@ -124,3 +128,43 @@ def plot_section(section, i: int = 0, j: int = 4, *, ax=None, color: str = "k", 
     ax.plot(section[:, i], section[:, j], ".", color=color, ms=3, label=label)
     ax.set(xlabel=names[i], ylabel=names[j])
     return fig
+
+
+def plot_fig5(frame: pd.DataFrame, ax=None):
+    """Fig. 5: steady-state range (rad) of the rotation error over (R, Theta), one
+    square per periodic point; slipping points as empty circles, irregular as crosses.
+    Returns the figure."""
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(7, 5))
+    fig = ax.figure
+    per = frame[frame.regime == "periodic"]
+    sc = ax.scatter(per.R, per.Theta, c=per["range"], marker="s", s=22, cmap="viridis", linewidths=0)
+    fig.colorbar(sc, ax=ax, label="range of $p$ (rad)")
+    slip = frame[frame.regime == "slipping"]
+    ax.scatter(slip.R, slip.Theta, facecolors="none", edgecolors="C3", s=30, label="slipping")
+    irr = frame[frame.regime == "irregular"]
+    ax.scatter(irr.R, irr.Theta, marker="x", color="k", s=14, lw=0.8, label="irregular")
+    ax.set(xlabel="R (m)", ylabel=r"$\Theta$ (rad/s)")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2)
+    return fig
+
+
+def plot_circle_map(frame: pd.DataFrame, body: Body, coexists=None, ax=None):
+    """Where the circle's rotation error settles or slips (``frame`` from
+    :func:`circle_final_state`), with the analytic boundary R_crit(theta) of (36)
+    and, if given, the points where slipping coexists with the stable equilibrium."""
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(7, 5))
+    for regime, style in (("settled", dict(color="C0", marker=".")), ("slipping", dict(color="C3", marker="x"))):
+        sel = frame[frame.regime == regime]
+        ax.scatter(sel.R, sel.theta, s=12, label=f"{regime} (from the reference)", **style)
+    if coexists is not None:
+        sel = frame[np.asarray(coexists, bool)]
+        ax.scatter(sel.R, sel.theta, s=60, facecolors="none", edgecolors="k",
+                   label="slipping coexists with $p_s$")
+    th = np.linspace(frame.theta.min(), frame.theta.max(), 300)
+    ax.plot([circle_critical_radius(body, x) for x in th], th, "k", lw=2, label=r"$R_{crit}(\theta)$, (36)")
+    ax.set(xlabel="R (m)", ylabel=r"$\theta$ (rad/s)")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2, fontsize=8)
+    return ax.figure
+

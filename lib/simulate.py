@@ -1,13 +1,14 @@
-"""Closed-loop simulation of eqs. (2)-(4) under the computed-torque law (23)
-with the position-only allocation (25)-(26).
+"""Closed-loop simulation of eqs. (2)-(4) under the computed-torque law (23) with an
+allocation (by default the paper's position-only (25)-(26)) and optional limits.
 
-Integration uses :func:`scipy.integrate.solve_ivp` with the 8th-order
-Dormand-Prince method (``DOP853``) and tolerances rtol = 1e-10, atol = 1e-10 by
-default. The right-hand side is smooth (when no limit is active), so a
-high-order method at tight tolerances reaches the 1e-8 agreement with the
-analytic error solution of (24) that the tests demand, in a few thousand steps.
-With force or angle limits the right-hand side is only piecewise smooth; the
-step-size control still resolves the switching, at some cost.
+:func:`simulate` takes its options grouped: a :class:`lib.allocation.Limits`, a
+:class:`lib.allocation.Allocation` and an :class:`Integration`. With
+``Integration(switching="stepsize")`` (the default) the closed loop
+(:class:`lib.closed_loop.ClosedLoop`) is integrated by one adaptive ``solve_ivp``
+run (:mod:`lib.integrators.smooth`); with an angle limit the field is then only
+piecewise smooth and the step-size control resolves the switching, at some
+cost. ``Integration(switching="events")`` locates every crossing of the switching
+surface and slides along it (:mod:`lib.integrators.switched`).
 """
 
 from __future__ import annotations
@@ -16,23 +17,24 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from scipy.integrate import solve_ivp
 
-from .control import allocate, allocate_least_squares, allocate_limited, computed_torque
-from .model import config_accel
+from .allocation import Allocation, Limits
+from .closed_loop import ClosedLoop, reference_of
+from .integrators.smooth import Integration, SimulationError, integrate
+from .integrators.switched import SwitchedLoop
+from .model import config_accel, config_from_state, state_from_config, state_rhs
 from .params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from .trajectories import Reference
 
-__all__ = ["SimulationError", "SimulationResult", "simulate", "DEFAULT_RTOL", "DEFAULT_ATOL"]
+__all__ = ["SimulationError", "SimulationResult", "simulate", "Integration", "simulate_open_loop",
+           "open_loop_comparison", "OPEN_LOOP_FORMS", "DEFAULT_RTOL", "DEFAULT_ATOL"]
 
-DEFAULT_RTOL = 1e-10
-DEFAULT_ATOL = 1e-10
+#: the default tolerances of :class:`Integration`
+DEFAULT_RTOL = Integration.rtol
+DEFAULT_ATOL = Integration.atol
 #: points per second of the default output grid
 DEFAULT_RATE = 20.0
-
-
-class SimulationError(RuntimeError):
-    """The closed-loop integration failed or the solution became non-finite."""
+_NAMES = ("x", "y", "phi", "xdot", "ydot", "phidot")
 
 
 @dataclass(frozen=True)
@@ -53,8 +55,8 @@ class SimulationResult:
     beta: np.ndarray
     tau: np.ndarray
     ref: Reference
-    #: with ``switching="events"``: +1 / -1 the side of the angle-limit switching
-    #: surface, 0 sliding on it (see :class:`lib.limits.SwitchedLoop`); else None
+    #: with ``Integration(switching="events")``: +1 / -1 the side of the angle-limit
+    #: switching surface, 0 sliding on it (see :class:`lib.integrators.switched.SwitchedLoop`); else None
     mode: np.ndarray | None = None
 
     @property
@@ -92,78 +94,32 @@ def _vector(name: str, value, default) -> np.ndarray:
     return arr
 
 
-ALLOCATIONS = ("position", "least_squares", "limited")
-
-
-def allocator(body: Body, allocation: str = "position", weights=(1.0, 1.0, 0.0), force_limit=None, angle_limit=None):
-    """The allocation step tau, phi -> (F, beta) of the closed loop.
-
-    ``"position"``: the paper's position-only law (25)-(26), :func:`lib.control.allocate`;
-    ``"least_squares"``: the weighted law :func:`lib.control.allocate_least_squares`
-    with ``weights`` = (w_x, w_y, w_phi) (Chapter 6), limits applied by projection;
-    ``"limited"``: the same weighted law solved exactly under the limits,
-    :func:`lib.control.allocate_limited`.
-    """
-    if allocation == "position":
-        allocate(np.zeros(2), 0.0, force_limit, angle_limit)  # validate once
-        return lambda tau, phi: allocate(tau, phi, force_limit, angle_limit)
-    if allocation == "least_squares":
-        allocate_least_squares(np.zeros(3), 0.0, body, weights, force_limit, angle_limit)  # validate once
-        return lambda tau, phi: allocate_least_squares(tau, phi, body, weights, force_limit, angle_limit)
-    if allocation == "limited":
-        allocate_limited(np.zeros(3), 0.0, body, weights, force_limit, angle_limit)  # validate once
-        return lambda tau, phi: allocate_limited(tau, phi, body, weights, force_limit, angle_limit)
-    raise ValueError(f"unknown allocation {allocation!r}; known: {ALLOCATIONS}")
-
-
-def closed_loop_rhs(body: Body, gains: Gains, ref: Reference, force_limit=None, angle_limit=None, *,
-                    allocation: str = "position", weights=(1.0, 1.0, 0.0)):
-    """The closed-loop vector field s' = F(t, s) with s = [z, dz] (length 6)."""
-    alloc = allocator(body, allocation, weights, force_limit, angle_limit)
-
-    def rhs(t: float, s: np.ndarray) -> np.ndarray:
-        z, dz = s[:3], s[3:]
-        tau = computed_torque(body, gains, ref, t, z, dz)
-        F, beta = alloc(tau, z[2])
-        out = np.concatenate([dz, config_accel(body, z, dz, F, beta)])
-        if not np.all(np.isfinite(out)):
-            bad = [n for n, v in zip(("x", "y", "phi", "xdot", "ydot", "phidot"), out) if not np.isfinite(v)]
-            raise SimulationError(f"closed loop became non-finite at t = {t:.6g} s in the rates of {bad}")
-        return out
-
-    return rhs
+def _instance(name: str, value, cls):
+    if value is None:
+        return cls()
+    if not isinstance(value, cls):
+        raise TypeError(f"{name} must be a {cls.__module__}.{cls.__name__}, got {type(value).__name__}")
+    return value
 
 
 def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz0=None, *,
-             force_limit: float | None = None, angle_limit: float | None = None,
-             t_eval=None, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
-             method: str = "DOP853", max_step: float = np.inf,
-             blowup: float = 1e8, switching: str = "stepsize", allocation: str = "position",
-             weights=(1.0, 1.0, 0.0)) -> SimulationResult:
-    """Integrate the closed loop (2)-(4), (23), (25)-(26) from t = 0 to ``t_end`` (s).
+             limits: Limits | None = None, allocation: Allocation | None = None, t_eval=None,
+             integration: Integration | None = None) -> SimulationResult:
+    """Integrate the closed loop (2)-(4), (23) with an allocation from t = 0 to ``t_end`` (s).
 
-    ``z0``, ``dz0``: initial configuration and rate (default: the paper's
-    Table, x = 1 m, y = 0, phi = pi/2, at rest). ``force_limit`` (N) and
-    ``angle_limit`` (rad) are passed to :func:`lib.control.allocate`.
-    ``t_eval``: output times (default: 20 per second). A state whose magnitude
-    exceeds ``blowup`` or that becomes non-finite raises :class:`SimulationError`
+    ``z0``, ``dz0``: initial configuration and rate (default: the paper's Table,
+    x = 1 m, y = 0, phi = pi/2, at rest). ``limits``: force and angle limits
+    (:class:`lib.allocation.Limits`, default none). ``allocation``: the allocation
+    law (:class:`lib.allocation.Allocation`, default the paper's (25)-(26)).
+    ``t_eval``: output times (default: 20 per second). ``integration``: method,
+    tolerances and switching (:class:`Integration`, default DOP853 at 1e-10). A
+    state that blows up or becomes non-finite raises :class:`SimulationError`
     naming the time and the variable.
 
-    ``switching`` says how an angle limit's discontinuity is integrated:
-    ``"stepsize"`` (default) leaves it to the step-size control of one
-    ``solve_ivp`` run; ``"events"`` locates every crossing of the switching
-    surface and slides along it where the two sides push against each other
-    (Filippov), with :class:`lib.limits.SwitchedLoop`. ``"events"`` needs an
-    ``angle_limit`` below pi; in the result, ``beta`` while sliding is the
-    Filippov average angle and ``mode`` records the side.
-
-    ``allocation`` selects the allocation step: ``"position"`` (default, the
-    paper's (25)-(26)), ``"least_squares"`` (the weighted law of Chapter 6,
-    :func:`lib.control.allocate_least_squares`, with ``weights`` =
-    (w_x, w_y, w_phi), limits by projection) or ``"limited"`` (the same law
-    solved exactly under the limits, :func:`lib.control.allocate_limited`); see
-    :func:`allocator`. The event-located switching
-    supports the position-only law only.
+    With ``Integration(switching="events")`` the angle limit's switching surface
+    is located (:class:`lib.integrators.switched.SwitchedLoop`): it needs an angle
+    limit below pi and the position-only law; in the result, ``beta`` while
+    sliding is the Filippov average angle and ``mode`` records the side.
     """
     if not isinstance(body, Body):
         raise TypeError(f"body must be a lib.params.Body, got {type(body).__name__}")
@@ -175,55 +131,44 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
         raise ValueError(f"t_end must be a positive finite time in s, got {t_end!r}")
     z0 = _vector("z0", z0, PAPER_Z0)
     dz0 = _vector("dz0", dz0, PAPER_DZ0)
+    limits = _instance("limits", limits, Limits)
+    allocation = _instance("allocation", allocation, Allocation)
+    integration = _instance("integration", integration, Integration)
     if t_eval is None:
         t_eval = np.linspace(0.0, t_end, int(round(t_end * DEFAULT_RATE)) + 1)
     t_eval = np.asarray(t_eval, dtype=float)
     if t_eval.ndim != 1 or t_eval.size == 0 or t_eval[0] < 0 or t_eval[-1] > t_end or np.any(np.diff(t_eval) <= 0):
         raise ValueError("t_eval must be a non-empty increasing 1-D array within [0, t_end]")
-    alloc = allocator(body, allocation, weights, force_limit, angle_limit)  # validates limits and weights
-    if switching not in ("stepsize", "events"):
-        raise ValueError(f"switching must be 'stepsize' or 'events', got {switching!r}")
-    if switching == "events":
-        if allocation != "position":
-            raise ValueError("switching='events' supports allocation='position' only")
-        return _simulate_events(body, gains, ref, t_end, z0, dz0, force_limit, angle_limit, t_eval,
-                                rtol, atol, method, max_step)
+    if integration.switching == "events":
+        if allocation.law != "position":
+            raise ValueError("switching='events' supports the position-only allocation only")
+        return _simulate_events(body, gains, ref, t_end, z0, dz0, limits, t_eval, integration)
 
-    rhs = closed_loop_rhs(body, gains, ref, force_limit, angle_limit, allocation=allocation, weights=weights)
+    loop = ClosedLoop.of(body, gains, reference_of(ref), allocation, limits)
 
-    def blew_up(t, s):
-        return blowup - np.max(np.abs(s))
+    def rhs(t: float, s: np.ndarray) -> np.ndarray:
+        out = loop.rates(t, s)[0]
+        if not np.all(np.isfinite(out)):
+            bad = [n for n, v in zip(_NAMES, out) if not np.isfinite(v)]
+            raise SimulationError(f"closed loop became non-finite at t = {t:.6g} s in the rates of {bad}")
+        return out
 
-    blew_up.terminal = True
-    sol = solve_ivp(rhs, (0.0, t_end), np.concatenate([z0, dz0]), method=method, t_eval=t_eval,
-                    rtol=rtol, atol=atol, max_step=max_step, events=blew_up)
-    if sol.status == 1:
-        s = sol.y_events[0][0]
-        names = ("x", "y", "phi", "xdot", "ydot", "phidot")
-        raise SimulationError(
-            f"closed loop blew up at t = {sol.t_events[0][0]:.6g} s: "
-            f"|{names[int(np.argmax(np.abs(s)))]}| reached {blowup:g}")
-    if sol.status != 0:
-        raise SimulationError(f"integration failed: {sol.message}")
-    z, dz = sol.y[:3].T, sol.y[3:].T
-    t = sol.t
-    tau = computed_torque(body, gains, ref, t, z, dz)
-    F, beta = alloc(tau, z[:, 2])
+    t, s = integrate(rhs, np.concatenate([z0, dz0]), t_end, t_eval, integration, _NAMES)
+    z, dz = s[:, :3], s[:, 3:]
+    tau, F, beta = loop.inputs(t, z, dz)
     return SimulationResult(t=t, z=z, dz=dz, z_d=ref.z(t), dz_d=ref.dz(t), F=F, beta=beta, tau=tau, ref=ref)
 
 
-def _simulate_events(body, gains, ref, t_end, z0, dz0, force_limit, angle_limit, t_eval,
-                     rtol, atol, method, max_step) -> SimulationResult:
-    """``simulate(..., switching="events")``: event-located integration (lib.limits)."""
-    from .limits import SwitchedLoop
-
-    if angle_limit is None or angle_limit >= np.pi:
+def _simulate_events(body, gains, ref, t_end, z0, dz0, limits: Limits, t_eval,
+                     integration: Integration) -> SimulationResult:
+    """``simulate`` with ``Integration(switching="events")``: :class:`SwitchedLoop`."""
+    if limits.angle is None or limits.angle >= np.pi:
         raise ValueError("switching='events' needs an angle_limit below pi (rad)")
-    loop = SwitchedLoop(body, gains, ref, angle_limit, force_limit)
-    seg = loop.integrate(np.concatenate([z0, dz0]), 0.0, float(t_end), t_eval=t_eval, rtol=rtol, atol=atol,
-                         method=method, max_step=max_step)
+    loop = SwitchedLoop(body, gains, ref, limits.angle, limits.force)
+    seg = loop.integrate(np.concatenate([z0, dz0]), 0.0, float(t_end), t_eval=t_eval, rtol=integration.rtol,
+                         atol=integration.atol, method=integration.method, max_step=integration.max_step)
     z, dz = seg.y[:, :3], seg.y[:, 3:]
-    tau = computed_torque(body, gains, ref, seg.t, z, dz)
+    tau = ClosedLoop.of(body, gains, reference_of(ref)).inputs(seg.t, z, dz)[0]
     return SimulationResult(t=seg.t, z=z, dz=dz, z_d=ref.z(seg.t), dz_d=ref.dz(seg.t), F=seg.F, beta=seg.beta,
                             tau=tau, ref=ref, mode=seg.mode)
 
@@ -242,8 +187,6 @@ def simulate_open_loop(body: Body, F, beta, q0, t_end: float, *, form: str = "co
     (n, 6) in body-frame state coordinates whatever the form, so the three can
     be compared directly.
     """
-    from .model import config_from_state, state_from_config, state_rhs
-
     if form not in OPEN_LOOP_FORMS:
         raise ValueError(f"unknown model form {form!r}; known: {OPEN_LOOP_FORMS}")
     if not (callable(F) and callable(beta)):
@@ -268,13 +211,10 @@ def simulate_open_loop(body: Body, F, beta, q0, t_end: float, *, form: str = "co
             return state_rhs(body, s, F(t), beta(t), printed=printed)
 
         s0 = q0
-    sol = solve_ivp(rhs, (0.0, t_end), s0, method="DOP853", t_eval=t_eval, rtol=rtol, atol=atol)
-    if sol.status != 0:
-        raise SimulationError(f"open-loop integration failed: {sol.message}")
-    q = sol.y.T
+    t, q = integrate(rhs, s0, t_end, t_eval, Integration(rtol=rtol, atol=atol), _NAMES)
     if form == "config":
         q = state_from_config(q[:, :3], q[:, 3:])
-    return sol.t, q
+    return t, q
 
 
 def _demo_force(t):

@@ -9,20 +9,23 @@ arrays or DataFrames; the figures are drawn by :mod:`lib.plotting`.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
 from scipy.optimize import brentq
 
-from .control import error_dynamics_solution, wrap_angle
+from .allocation import Limits
+from .angles import wrap_angle
+from .control import error_dynamics_solution
 from .params import Body, Gains
-from .simulate import SimulationResult, simulate
+from .simulate import Integration, SimulationResult, simulate
 from .trajectories import Reference, make
 
 __all__ = [
     "run", "steady_mask", "restrict", "rotation_error_continuous", "position_deviation_from_eq24",
     "steady_summary", "eight_sensitivity", "force_cap_sweep", "saturated_intervals",
-    "circle_rotation_equilibrium", "ERRATA",
+    "circle_rotation_equilibrium",
 ]
 
 
@@ -31,7 +34,7 @@ def run(body: Body, gains: Gains, name: str, R: float, theta: float, n_periods: 
     """Simulate tracking of the named reference ("circle" (27) or "eight" (28)) of
     radius R (m) and rate theta (rad/s) for ``n_periods`` periods from the paper's
     initial state, sampled ``samples_per_period`` times per period. Extra keywords
-    go to :func:`lib.simulate.simulate` (e.g. ``force_limit``)."""
+    go to :func:`lib.simulate.simulate` (e.g. ``limits``, ``integration``)."""
     ref = make(name, R, theta)
     t_end = n_periods * ref.period
     n = int(round(n_periods * samples_per_period))
@@ -47,8 +50,6 @@ def steady_mask(res: SimulationResult, n_periods: float) -> np.ndarray:
 
 def restrict(res: SimulationResult, mask) -> SimulationResult:
     """The samples of ``res`` selected by the boolean ``mask`` (e.g. :func:`steady_mask`)."""
-    from dataclasses import replace
-
     mask = np.asarray(mask, dtype=bool)
     if mask.shape != res.t.shape or not mask.any():
         raise ValueError("mask must be a boolean array like res.t selecting at least one sample")
@@ -92,7 +93,7 @@ def eight_sensitivity(body: Body, gains: Gains, Rs, thetas, *, n_periods: float 
     for R in np.atleast_1d(Rs):
         for th in np.atleast_1d(thetas):
             res = run(body, gains, "eight", float(R), float(th), n_periods, samples_per_period=100,
-                      rtol=1e-9, atol=1e-9)
+                      integration=Integration(rtol=1e-9, atol=1e-9))
             rows.append({"R": float(R), "theta": float(th), **steady_summary(res, n_steady)})
     return pd.DataFrame(rows)
 
@@ -125,7 +126,8 @@ def force_cap_sweep(body: Body, gains: Gains, ref: Reference, caps, *, n_periods
     t_end = n_periods * ref.period
     t_eval = np.linspace(0.0, t_end, int(n_periods * 200) + 1)
     for cap in np.atleast_1d(np.asarray(caps, dtype=float)):
-        res = simulate(body, gains, ref, t_end, t_eval=t_eval, force_limit=float(cap), rtol=1e-8, atol=1e-8)
+        res = simulate(body, gains, ref, t_end, t_eval=t_eval, limits=Limits(force=float(cap)),
+                       integration=Integration(rtol=1e-8, atol=1e-8))
         m = steady_mask(res, n_steady)
         e = res.error[m]
         rows.append({"cap": float(cap), "pos_err_max": float(np.hypot(e[:, 0], e[:, 1]).max()),
@@ -155,52 +157,3 @@ def circle_rotation_equilibrium(body: Body, R: float, theta: float) -> float:
     if not stable:
         raise ValueError(f"no rotation equilibrium for R = {R} m, theta = {theta} rad/s")
     return float(stable[0])
-
-
-# ------------------------------------------------------------------ errata (Secs. 4-5)
-
-
-#: The lines of the paper that name its parameter table, transcribed from the
-#: published text (Korczak 2014, Sec. 5): every table caption, and every sentence
-#: that refers to a table. Kept here as data so that the check below reads
-#: nothing outside the repository.
-PAPER_TABLE_LINES = (
-    "Tab. 1 presents system and control parameters, Fig. 2 shows the results for circular trajectory.",
-    "Table 5. System and control parameters",
-)
-
-
-def _check_table_number(lines=PAPER_TABLE_LINES):
-    """The paper's only table is captioned "Table 5"; the text refers to it as "Tab. 1"."""
-    import re
-
-    from .errata import Verdict
-
-    captions = [m.group(0) for line in lines if (m := re.match(r"Table\s+\d+", line))]
-    refs = [r for line in lines for r in re.findall(r"Tab\.\s*\d+", line)]
-    n_tables = len(captions)
-    # a caption "Table 5" is right only if the paper had at least five tables
-    return Verdict(printed_holds=n_tables >= 5,
-                   corrected_holds=n_tables == 1 and all(r.endswith("1") for r in refs),
-                   detail=f"table captions {captions}, text references {refs}: {n_tables} table(s)")
-
-
-def _errata():
-    from .errata import Erratum
-
-    return [
-        Erratum(
-            key="table-number",
-            where="Sec. 5, caption of the parameter table",
-            printed="Table 5",
-            corrected="Table 1 (the paper's only table; the text cites it as Tab. 1)",
-            verified_by="count of table captions and of table references in the paper's text "
-                        "(`lib.tracking._check_table_number`); a text check can show the numbering is "
-                        "inconsistent, not what the typesetter intended",
-            section="chapters/03_tracking",
-            check=_check_table_number,
-        ),
-    ]
-
-
-ERRATA = _errata()

@@ -13,7 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["Reference", "Circle", "Eight", "circle", "eight", "make", "NAMES", "circle_kinematics",
-           "eight_kinematics", "KINEMATICS"]
+           "eight_kinematics", "KINEMATICS", "circle_position", "eight_position", "position_kinematics", "POSITIONS",
+           "eight_heading_fourier", "heading_series", "PAPER_HEADING_SERIES"]
 
 
 def _check_shape(R: float, theta: float) -> tuple[float, float]:
@@ -106,18 +107,41 @@ class Eight(_Path):
         return self.z(t)[..., 2]
 
 
+def circle_position(R, theta, t) -> tuple:
+    """Position of the circle (27) and its first three time derivatives, as the tuple
+    (x_d, y_d, vx_d, vy_d, ax_d, ay_d, jx_d, jy_d) (m, m/s, m/s^2, m/s^3).
+
+    The one definition of (27)'s position: written with numpy functions, so it takes
+    scalars (the switched integrator calls it per step) as well as arrays.
+    """
+    s = theta * t
+    c, sn = np.cos(s), np.sin(s)
+    return (R * c, R * sn, -R * theta * sn, R * theta * c, -R * theta**2 * c, -R * theta**2 * sn,
+            R * theta**3 * sn, -R * theta**3 * c)
+
+
+def eight_position(R, theta, t) -> tuple:
+    """Position of the eight (28), x_d = R/2 sin 2 theta t, y_d = R sin theta t, and its
+    first three time derivatives, ordered as in :func:`circle_position`."""
+    s = theta * t
+    c1, s1, c2, s2 = np.cos(s), np.sin(s), np.cos(2 * s), np.sin(2 * s)
+    return (0.5 * R * s2, R * s1, R * theta * c2, R * theta * c1, -2 * R * theta**2 * s2, -R * theta**2 * s1,
+            -4 * R * theta**3 * c2, -R * theta**3 * c1)
+
+
 def circle_kinematics(R, theta, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(z_d, dz_d, ddz_d) of the circle (27), broadcast over arrays R (m), theta (rad/s), t (s).
 
     Unvalidated array form behind :class:`Circle`, for batch computations;
-    each array has shape broadcast(R, theta, t) + (3,).
+    each array has shape broadcast(R, theta, t) + (3,). The heading is
+    phi_d = theta t + pi/2.
     """
     R, th, t = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (R, theta, t)))
+    x, y, vx, vy, ax, ay, _, _ = circle_position(R, th, t)
     s = th * t
-    c, sn = np.cos(s), np.sin(s)
-    z = np.stack([R * c, R * sn, s + np.pi / 2], axis=-1)
-    dz = np.stack([-R * th * sn, R * th * c, th], axis=-1)
-    ddz = np.stack([-R * th**2 * c, -R * th**2 * sn, np.zeros_like(s)], axis=-1)
+    z = np.stack([x, y, s + np.pi / 2], axis=-1)
+    dz = np.stack([vx, vy, th], axis=-1)
+    ddz = np.stack([ax, ay, np.zeros_like(s)], axis=-1)
     return z, dz, ddz
 
 
@@ -131,6 +155,7 @@ def eight_kinematics(R, theta, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     N' = 3 cos s cos 2s, D' = -2 sin 4s - sin 2s.
     """
     R, th, t = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (R, theta, t)))
+    x, y, vx, vy, ax, ay, _, _ = eight_position(R, th, t)
     s = th * t
     c1, s1, c2, s2 = np.cos(s), np.sin(s), np.cos(2 * s), np.sin(2 * s)
     heading = np.pi + np.arctan2(-c1, -c2) - np.where(th < 0, np.pi, 0.0)
@@ -138,10 +163,28 @@ def eight_kinematics(R, theta, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     den = c2**2 + c1**2
     dnum = 3 * c1 * c2
     dden = -2 * np.sin(4 * s) - s2
-    z = np.stack([0.5 * R * s2, R * s1, heading], axis=-1)
-    dz = np.stack([R * th * c2, R * th * c1, th * num / den], axis=-1)
-    ddz = np.stack([-2 * R * th**2 * s2, -R * th**2 * s1, th**2 * (dnum * den - num * dden) / den**2], axis=-1)
+    z = np.stack([x, y, heading], axis=-1)
+    dz = np.stack([vx, vy, th * num / den], axis=-1)
+    ddz = np.stack([ax, ay, th**2 * (dnum * den - num * dden) / den**2], axis=-1)
     return z, dz, ddz
+
+
+def position_kinematics(ref: Reference):
+    """Scalar function t -> (x_d, y_d, vx_d, vy_d, ax_d, ay_d, jx_d, jy_d) of a reference:
+    position (m), velocity, acceleration and jerk (needed by the rate of the switching
+    function of :class:`lib.integrators.switched.SwitchedLoop`). Exact for the circle
+    (27) and the eight (28) (:func:`circle_position`, :func:`eight_position`); for
+    another reference the jerk is a fourth-order central difference of ``ref.ddz``."""
+    if isinstance(ref, _Path):
+        position, R, th = POSITIONS[ref._kind], ref.R, ref.theta
+        return lambda t: position(R, th, t)
+
+    def kin(t: float) -> tuple:
+        h = 1e-3
+        z, dz, ddz = ref.z(t), ref.dz(t), ref.ddz(t)
+        j = (ref.ddz(t - 2 * h) - 8 * ref.ddz(t - h) + 8 * ref.ddz(t + h) - ref.ddz(t + 2 * h)) / (12 * h)
+        return (z[0], z[1], dz[0], dz[1], ddz[0], ddz[1], j[0], j[1])
+    return kin
 
 
 def circle(R: float = 2.0, theta: float = math.pi / 4) -> Circle:
@@ -169,3 +212,34 @@ def make(name: str, R: float, theta: float) -> Reference:
 
 #: the array forms, by name, for batch computations over many (R, theta)
 KINEMATICS = {"circle": circle_kinematics, "eight": eight_kinematics}
+#: the position with three derivatives, by name (:func:`position_kinematics`)
+POSITIONS = {"circle": circle_position, "eight": eight_position}
+
+
+# ------------------------------------------------------------------ the eight's tangent angle as a series (Sec. 6)
+
+#: The paper's 3-term approximation of the eight's tangent angle (Sec. 6):
+#: phi_d ~ pi - 2.26 cos s - 0.24 cos 3s + 0.16 cos 5s, s = Theta t.
+PAPER_HEADING_SERIES = {0: math.pi, 1: -2.26, 3: -0.24, 5: 0.16}
+
+
+def eight_heading_fourier(n_harmonics: int = 9, n_samples: int = 4096) -> np.ndarray:
+    """Cosine Fourier coefficients a_0..a_{n_harmonics} of the eight's continuous
+    tangent angle phi_d(s) = pi + atan2(-cos s, -cos 2s) (rad), s = Theta t, by FFT.
+
+    phi_d is even in s, so phi_d = a_0 + sum_k a_k cos(k s); the half-period
+    symmetry phi_d(s + pi) - pi = -(phi_d(s) - pi) leaves only odd k."""
+    if not isinstance(n_harmonics, (int, np.integer)) or n_harmonics < 0:
+        raise ValueError(f"n_harmonics must be a non-negative integer, got {n_harmonics!r}")
+    s = 2 * np.pi * np.arange(n_samples) / n_samples
+    H = eight_kinematics(1.0, 1.0, s)[0][..., 2]
+    c = np.fft.rfft(H) / n_samples
+    a = 2 * c.real
+    a[0] = c[0].real
+    return a[: n_harmonics + 1]
+
+
+def heading_series(coefficients: dict, s) -> np.ndarray:
+    """Evaluate a cosine series {k: a_k} at phases s (rad)."""
+    s = np.asarray(s, dtype=float)
+    return sum(a * np.cos(k * s) for k, a in coefficients.items())

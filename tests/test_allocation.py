@@ -6,8 +6,10 @@ import sympy as sp
 from hypothesis import given, settings, strategies as st
 from hypothesis.extra.numpy import arrays
 
-from lib import control, model
-from lib.params import Body
+from lib import control, model, trajectories
+from lib.allocation import Allocation, Limits, least_squares_problem, allocate, allocate_least_squares, allocate_limited, residual
+from lib.params import Body, Gains
+from lib.simulate import Integration, simulate
 
 vec3 = arrays(float, 3, elements=st.floats(-20, 20))
 weights = st.tuples(st.floats(0.0, 5.0), st.floats(0.0, 5.0), st.floats(0.0, 5.0)).filter(lambda w: max(w) > 0.01)
@@ -102,18 +104,16 @@ def test_per_demand_weights_equal_one_call_per_weight():
 
 def _grid_min(tau, phi, body, W, fmax, bmax):
     """Brute force: the least residual over a polar grid of the admissible sector."""
-    from lib.control import _least_squares
 
     R, B = np.meshgrid(np.linspace(0.0, fmax, 201), np.linspace(-bmax, bmax, 541))
     U = np.stack([R * np.cos(B), R * np.sin(B)], -1).reshape(-1, 2)
-    _, G, r, bb = _least_squares(tau, phi, body, W)
+    _, G, r, bb = least_squares_problem(tau, phi, body, W)
     return (np.einsum("mi,nij,mj->nm", U, G, U) - 2 * r @ U.T + bb[:, None]).min(axis=1), (G, r, bb)
 
 
 @pytest.mark.parametrize("fmax, bmax", [(2.0, 0.4), (1.5, 1.2), (2.5, 2.2), (1.0, 3.0), (1.2, np.pi)])
 def test_limited_allocation_is_the_optimum_over_the_admissible_sector(fmax, bmax):
     # random demands, headings and weights; beta_max > pi/2 makes the sector non-convex
-    from lib.control import allocate_limited, residual
 
     rng = np.random.default_rng(7)
     n = 400
@@ -129,12 +129,10 @@ def test_limited_allocation_is_the_optimum_over_the_admissible_sector(fmax, bmax
 
 
 def test_limited_allocation_beats_projection_and_reduces_without_limits():
-    from lib.control import _least_squares, allocate, allocate_least_squares, allocate_limited, residual
-
     rng = np.random.default_rng(3)
     tau, phi = rng.normal(size=(300, 3)) * [3.0, 3.0, 1.0], rng.uniform(-np.pi, np.pi, 300)
     W = (1.0, 1.0, 0.5)
-    _, G, r, bb = _least_squares(tau, phi, Body(), W)
+    _, G, r, bb = least_squares_problem(tau, phi, Body(), W)
 
     def J(F, beta):
         return residual(np.stack([F * np.cos(beta), F * np.sin(beta)], -1), G, r, bb)
@@ -156,18 +154,12 @@ def test_limited_allocation_beats_projection_and_reduces_without_limits():
 @pytest.mark.parametrize("kw, msg", [({"force_limit": -1.0}, "force_limit"), ({"angle_limit": 4.0}, "angle_limit"),
                                      ({"weights": (0.0, 0.0, 0.0)}, "weights")])
 def test_limited_allocation_rejects_bad_input(kw, msg):
-    from lib.control import allocate_limited
-
     with pytest.raises(ValueError, match=msg):
         allocate_limited(np.ones(3), 0.0, Body(), **{"weights": (1.0, 1.0, 0.0), **kw})
 
 
 def test_simulate_runs_the_exact_limited_allocation_within_its_limits():
-    from lib import trajectories
-    from lib.params import Gains
-    from lib.simulate import simulate
-
-    res = simulate(Body(), Gains(), trajectories.eight(), 16.0, force_limit=4.0, angle_limit=1.0,
-                   allocation="limited", weights=(1.0, 1.0, 0.1), rtol=1e-8, atol=1e-8)
+    res = simulate(Body(), Gains(), trajectories.eight(), 16.0, limits=Limits(force=4.0, angle=1.0),
+                   allocation=Allocation("limited", (1.0, 1.0, 0.1)), integration=Integration(rtol=1e-8, atol=1e-8))
     assert res.F.max() <= 4.0 + 1e-12 and np.abs(res.beta).max() <= 1.0 + 1e-12
     assert np.isclose(res.F.max(), 4.0)                      # the cap binds on this run

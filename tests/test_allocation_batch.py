@@ -3,7 +3,9 @@
 import numpy as np
 import pytest
 
-from lib import allocation, trajectories as T
+from lib import trajectories as T, weighting
+from lib.allocation import Allocation, Limits
+from lib.simulate import Integration
 from lib.params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from lib.simulate import simulate
 
@@ -12,18 +14,18 @@ from lib.simulate import simulate
 def test_batch_rk4_agrees_with_adaptive_simulation(kind, w_phi):
     body, gains = Body(), Gains()
     t_end = 20.0
-    batch = allocation.closed_loop_batch(body, gains, kind, 2.0, np.pi / 4, (1.0, 1.0, w_phi), t_end=t_end,
+    batch = weighting.closed_loop_batch(body, gains, kind, 2.0, np.pi / 4, (1.0, 1.0, w_phi), t_end=t_end,
                                          dt=0.02, record_dt=0.5, z0=PAPER_Z0, dz0=PAPER_DZ0)
     ref = T.make(kind, 2.0, np.pi / 4)
-    exact = simulate(body, gains, ref, t_end, t_eval=batch.t, allocation="least_squares",
-                     weights=(1.0, 1.0, w_phi), rtol=1e-11, atol=1e-11)
+    exact = simulate(body, gains, ref, t_end, t_eval=batch.t, allocation=Allocation("least_squares", (1.0, 1.0, w_phi)),
+                     integration=Integration(rtol=1e-11, atol=1e-11))
     assert np.abs(batch.z[:, 0, :] - exact.z).max() < 1e-5
     np.testing.assert_allclose(batch.F[:, 0], exact.F, atol=1e-4)
 
 
 def test_rk4_error_shrinks_at_fourth_order():
     body, gains = Body(), Gains()
-    runs = [allocation.closed_loop_batch(body, gains, "eight", 2.0, 1.0, (1, 1, 1), t_end=10.0, dt=dt,
+    runs = [weighting.closed_loop_batch(body, gains, "eight", 2.0, 1.0, (1, 1, 1), t_end=10.0, dt=dt,
                                          record_dt=0.4, z0=PAPER_Z0, dz0=PAPER_DZ0) for dt in (0.08, 0.04, 0.02)]
     e1 = np.abs(runs[0].z - runs[2].z).max()
     e2 = np.abs(runs[1].z - runs[2].z).max()
@@ -32,22 +34,22 @@ def test_rk4_error_shrinks_at_fourth_order():
 
 
 def test_paper_law_from_the_reference_keeps_position_error_at_integration_error():
-    res = allocation.closed_loop_batch(Body(), Gains(), "eight", [1.0, 3.0], [0.5, 1.2], (1, 1, 0), t_end=30.0)
+    res = weighting.closed_loop_batch(Body(), Gains(), "eight", [1.0, 3.0], [0.5, 1.2], (1, 1, 0), t_end=30.0)
     assert res.position_error.max() < 1e-7
 
 
 def test_steady_metrics_flag_a_body_that_leaves_the_circle():
-    res = allocation.closed_loop_batch(Body(), Gains(), "circle", 2.0, np.pi / 4, [(1, 1, 0), (1, 1, 10)],
+    res = weighting.closed_loop_batch(Body(), Gains(), "circle", 2.0, np.pi / 4, [(1, 1, 0), (1, 1, 10)],
                                        t_end=100.0, dt=0.02, z0=PAPER_Z0, dz0=PAPER_DZ0)
-    m = allocation.steady_metrics(res)
+    m = weighting.steady_metrics(res)
     assert m.position_held.tolist() == [True, False]
     assert m.pos_rms[0] < 1e-6 and m.pos_rms[1] > 10.0
 
 
 def test_steady_metrics_need_enough_periods():
-    res = allocation.closed_loop_batch(Body(), Gains(), "eight", 2.0, 0.1, (1, 1, 0), t_end=20.0)
+    res = weighting.closed_loop_batch(Body(), Gains(), "eight", 2.0, 0.1, (1, 1, 0), t_end=20.0)
     with pytest.raises(ValueError, match="shorter than 3 reference periods"):
-        allocation.steady_metrics(res)
+        weighting.steady_metrics(res)
 
 
 @pytest.mark.parametrize("kw,exc,msg", [
@@ -64,28 +66,28 @@ def test_batch_rejects_bad_input(kw, exc, msg):
     args = dict(body=Body(), gains=Gains(), kind="eight", R=[1.0], Theta=[1.0], weights=(1, 1, 1), t_end=1.0)
     args.update(kw)
     with pytest.raises(exc, match=msg):
-        allocation.closed_loop_batch(**args)
+        weighting.closed_loop_batch(**args)
 
 
 def test_simulate_allocation_option_is_validated():
     with pytest.raises(ValueError, match="unknown allocation 'torque'"):
-        simulate(Body(), Gains(), T.circle(), 1.0, allocation="torque")
+        simulate(Body(), Gains(), T.circle(), 1.0, allocation=Allocation("torque"))
     with pytest.raises(ValueError, match="weights"):
-        simulate(Body(), Gains(), T.circle(), 1.0, allocation="least_squares", weights=(1, 1))
-    with pytest.raises(ValueError, match="supports allocation='position' only"):
-        simulate(Body(), Gains(), T.circle(), 1.0, angle_limit=1.0, switching="events",
-                 allocation="least_squares", weights=(1, 1, 1))
+        simulate(Body(), Gains(), T.circle(), 1.0, allocation=Allocation("least_squares", (1, 1)))
+    with pytest.raises(ValueError, match="supports the position-only allocation only"):
+        simulate(Body(), Gains(), T.circle(), 1.0, limits=Limits(angle=1.0), integration=Integration(switching="events"),
+                 allocation=Allocation("least_squares", (1, 1, 1)))
 
 
 def test_map_comparison_classifies_both_laws_from_the_same_start():
     from lib import stability
 
     R, Th = np.array([3.0, 0.25]), np.array([0.3, 1.0])
-    cmp = allocation.compare_on_map(Body(), Gains(), R, Th, 0.1, t_end=3 * 2 * np.pi / 0.3 + 20.0)
+    cmp = weighting.compare_on_map(Body(), Gains(), R, Th, 0.1, t_end=3 * 2 * np.pi / 0.3 + 20.0)
     paper = stability.eight_rotation_sweep(Body(), R, Th)
     np.testing.assert_array_equal(cmp.lost, paper.regime.to_numpy() != "periodic")
     assert cmp.counts == {"lost": int(cmp.lost.sum()), "rescued": int((cmp.lost & cmp.held).sum()),
                           "broken": int((~cmp.lost & ~cmp.held).sum())}
     assert cmp.lost.tolist() == [False, True]   # a slow wide eight settles, a fast tight one slips
     with pytest.raises(ValueError, match="R"):
-        allocation.compare_on_map(Body(), Gains(), [-1.0], [0.3], 0.1, t_end=10.0)
+        weighting.compare_on_map(Body(), Gains(), [-1.0], [0.3], 0.1, t_end=10.0)

@@ -2,7 +2,7 @@
 
 import pytest
 
-from lib import errata
+from lib.paper import errata
 
 ROWS = errata.rows()
 
@@ -21,7 +21,7 @@ def test_errata_rows_are_complete():
 
 
 def test_table_number_check_reads_its_evidence_from_the_repository():
-    from lib.tracking import PAPER_TABLE_LINES, _check_table_number
+    from lib.paper.tracking_errata import PAPER_TABLE_LINES, _check_table_number
 
     v = _check_table_number()
     assert not v.printed_holds and v.corrected_holds

@@ -7,7 +7,11 @@ from hypothesis import given, settings, strategies as st_
 from flows import damped_oscillator_flow, driven_pendulum_flow
 from lib import limits as L, trajectories as T
 from lib.params import Body, Gains
-from lib.simulate import simulate
+from lib.allocation import Limits
+from lib.closed_loop import ClosedLoop, reference_of
+from lib.control import computed_torque, computed_torque_rate
+from lib.model import config_accel
+from lib.simulate import Integration, simulate
 
 S0 = np.array([1.0, 0.0, math.pi / 2, 0.0, 0.0, 0.0])
 
@@ -67,7 +71,8 @@ def test_section_period_sees_slow_convergence_and_not_a_rotation():
 @pytest.mark.parametrize("switching", ["stepsize", "events"])
 def test_beta_never_exceeds_angle_limit(switching):
     bmax = np.deg2rad(30)
-    res = simulate(Body(), Gains(), T.eight(), 24.0, angle_limit=bmax, switching=switching, rtol=1e-8, atol=1e-8)
+    res = simulate(Body(), Gains(), T.eight(), 24.0, limits=Limits(angle=bmax),
+                   integration=Integration(rtol=1e-8, atol=1e-8, switching=switching))
     assert np.all(np.abs(res.beta) <= bmax + 1e-12)
 
 
@@ -110,9 +115,10 @@ def test_event_located_and_stepsize_runs_agree_at_tight_tolerance(perturb):
     # no sliding in these 12 s; measured agreement 4e-10..1e-8 m: a margin of 1000 on 1e-5
     ref, bmax = T.eight(), np.deg2rad(60)
     s0 = perturb(S0)
-    a = simulate(Body(), Gains(), ref, 12.0, s0[:3], s0[3:], angle_limit=bmax, switching="events",
-                 rtol=1e-11, atol=1e-11)
-    b = simulate(Body(), Gains(), ref, 12.0, s0[:3], s0[3:], angle_limit=bmax, rtol=1e-11, atol=1e-11)
+    a = simulate(Body(), Gains(), ref, 12.0, s0[:3], s0[3:], limits=Limits(angle=bmax),
+                 integration=Integration(rtol=1e-11, atol=1e-11, switching="events"))
+    b = simulate(Body(), Gains(), ref, 12.0, s0[:3], s0[3:], limits=Limits(angle=bmax),
+                 integration=Integration(rtol=1e-11, atol=1e-11))
     assert np.all(a.mode != 0)
     assert np.abs(a.z - b.z).max() < 1e-5
 
@@ -152,9 +158,9 @@ def test_switched_loop_rejects_bad_limits(kw, msg):
 
 def test_simulate_events_needs_an_angle_limit():
     with pytest.raises(ValueError, match="angle_limit below pi"):
-        simulate(Body(), Gains(), T.eight(), 1.0, switching="events")
+        simulate(Body(), Gains(), T.eight(), 1.0, integration=Integration(switching="events"))
     with pytest.raises(ValueError, match="switching"):
-        simulate(Body(), Gains(), T.eight(), 1.0, switching="magic")
+        simulate(Body(), Gains(), T.eight(), 1.0, integration=Integration(switching="magic"))
 
 
 def test_angle_limit_60_degrees_gives_a_stable_period_two_motion(perturb):
@@ -201,11 +207,8 @@ def test_section_margin_measures_distance_from_the_tolerance():
 @given(t=st_.floats(0.0, 50.0), s=st_.lists(st_.floats(-5.0, 5.0), min_size=6, max_size=6),
        kind=st_.sampled_from(["circle", "eight"]), F=st_.floats(0.0, 10.0), beta=st_.floats(-3.0, 3.0))
 def test_switched_loop_scalar_fast_path_is_eqs_23_and_2_4(t, s, kind, F, beta):
-    # SwitchedLoop keeps scalar copies of (23), (2)-(4) and (27)-(28) for speed; they must
-    # be the library's single definitions at every state
-    from lib.control import computed_torque
-    from lib.model import config_accel
-
+    # SwitchedLoop keeps a scalar fast path of (23), its rate, (2)-(4) and the allocation for
+    # speed; it must be the library's single definitions at every state
     ref = T.make(kind, 1.7, 0.6)
     loop = L.SwitchedLoop(Body(), Gains(), ref, 0.5)
     s = np.array(s)
@@ -214,8 +217,21 @@ def test_switched_loop_scalar_fast_path_is_eqs_23_and_2_4(t, s, kind, F, beta):
     np.testing.assert_allclose([tx, ty], tau[:2], rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(loop._accel(s, F, beta), config_accel(Body(), s[:3], s[3:], F, beta),
                                rtol=1e-12, atol=1e-12)
-    kin = L.reference_kinematics(ref)(t)
+    kin = T.position_kinematics(ref)(t)
     np.testing.assert_allclose(kin[:6], np.r_[ref.z(t)[:2], ref.dz(t)[:2], ref.ddz(t)[:2]], rtol=1e-12, atol=1e-12)
     h = 1e-4
     jerk = (ref.ddz(t + h) - ref.ddz(t - h)) / (2 * h)
     np.testing.assert_allclose(kin[6:], jerk[:2], rtol=1e-6, atol=1e-6)
+    # the rate of the switching function from the rate of (23)
+    ax, ay, _ = loop._accel(s, F, beta)
+    dtau = computed_torque_rate(Body(), Gains(), ref.dz(t), ref.ddz(t), np.r_[kin[6:], 0.0], s[3:], [ax, ay, 0.0])
+    c, sn = np.cos(s[2]), np.sin(s[2])
+    lat_rate = dtau[1] * c - dtau[0] * sn - s[5] * (tau[0] * c + tau[1] * sn)
+    rate = loop._lat_rate(t, s, ax, ay, tx, ty, loop._tau(t, s)[2])
+    np.testing.assert_allclose(rate, lat_rate, rtol=1e-10, atol=1e-10 * (1 + np.abs(dtau[:2]).max()))
+    # off the switching surface, the side field is the closed loop with the angle clipped
+    lat = ty * c - tx * sn
+    if abs(lat) > 1e-9:
+        loop_ref = ClosedLoop.of(Body(), Gains(), reference_of(ref), limits=Limits(angle=0.5))
+        np.testing.assert_allclose(loop.rhs(t, s, 1 if lat > 0 else -1), loop_ref.rates(t, s)[0],
+                                   rtol=1e-12, atol=1e-12)

@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from lib import orbits, stability
+from lib import rotation, stability
+from lib.dynamics import orbits
 from lib.params import Body
 
 BODY = Body()
@@ -61,7 +62,7 @@ def test_newton_finds_the_henon_fixed_point():
 
 
 def test_rotation_period_map_jacobian_matches_finite_differences():
-    step = orbits.rotation_period_map(BODY, "eight", [2.0, 1.0], [math.pi / 4, 1.1], steps=256)
+    step = rotation.rotation_period_map(BODY, "eight", [2.0, 1.0], [math.pi / 4, 1.1], steps=256)
     x = np.array([[2.5, -0.3], [3.0, 0.4]])
     _, J = step(x)
     h = 1e-6
@@ -74,13 +75,13 @@ def test_paper_eight_has_an_attracting_period_one_orbit_that_the_transient_reach
     # period-1 orbit; its slowest multiplier is the rate at which the simulated transient
     # from the reference start closes in on it, period after period
     R, Th = 2.0, math.pi / 4
-    orb = orbits.rotation_orbit(BODY, "eight", [R], [Th])
+    orb = rotation.rotation_orbit(BODY, "eight", [R], [Th])
     assert orb.converged[0] and orb.attracting[0]
     lam1 = abs(orb.multipliers[0, 0])
     assert 0.9 < lam1 < 0.95
     n = int(stability.steps_per_period(BODY, "eight", [R], [Th])[0])
     t, p = stability.reduced_rotation(BODY, "eight", R, Th, 120, steps=n)
-    p_orbit = orb.x[0, 0] - stability._shape("eight")[0](0.0)[4]
+    p_orbit = orb.x[0, 0] - rotation._shape("eight")[0](0.0)[4]
     gap = np.abs(p[::n] - p_orbit)                  # distance at t = jT from the orbit's point
     assert gap[-1] < 1e-3 * gap[20]                 # the transient does reach this orbit
     rate = (gap[100] / gap[60]) ** (1 / 40)
@@ -94,11 +95,11 @@ def test_bad_input_raises_clear_errors():
     with pytest.raises(ValueError, match="x0"):
         orbits.newton_orbit(step, [[np.nan, 0.0]], 1)
     with pytest.raises(ValueError, match="kind"):
-        orbits.rotation_period_map(BODY, "square", [1.0], [1.0])
+        rotation.rotation_period_map(BODY, "square", [1.0], [1.0])
     with pytest.raises(ValueError, match="R"):
-        orbits.rotation_period_map(BODY, "eight", [-1.0], [1.0])
+        rotation.rotation_period_map(BODY, "eight", [-1.0], [1.0])
     with pytest.raises(ValueError, match="shape"):
-        orbits.rotation_period_map(BODY, "eight", [1.0], [1.0], steps=64)(np.zeros((2, 2)))
+        rotation.rotation_period_map(BODY, "eight", [1.0], [1.0], steps=64)(np.zeros((2, 2)))
     with pytest.raises(ValueError, match="jacobian"):
         orbits.floquet_multipliers(np.zeros(3))
 
@@ -110,10 +111,10 @@ def test_rotation_lyapunov_has_the_sign_of_the_motion(perturb):
     # positive by a margin (measured 0.22 +- 0.024 1/s over 100 periods: 9 standard errors)
     R, Th = np.array([2.0, 3.134615]), np.array([math.pi / 4, 0.8])
     dp0 = perturb(np.zeros(2))
-    ly = orbits.rotation_lyapunov(BODY, "eight", R, Th, periods=80, transient=20, steps=512, p0=dp0)
-    orb = orbits.rotation_orbit(BODY, "eight", R[:1], Th[:1], steps=512)
+    ly = rotation.rotation_lyapunov(BODY, "eight", R, Th, periods=80, transient=20, steps=512, p0=dp0)
+    orb = rotation.rotation_orbit(BODY, "eight", R[:1], Th[:1], steps=512)
     expected = math.log(abs(orb.multipliers[0, 0])) * Th[0] / (2 * math.pi)
     assert ly.value[0] == pytest.approx(expected, abs=1e-3) and ly.value[0] < -10 * ly.stderr[0]
     assert ly.value[1] > 6 * ly.stderr[1] and ly.value[1] > 0.05
     with pytest.raises(ValueError, match="periods"):
-        orbits.rotation_lyapunov(BODY, "eight", R, Th, periods=1)
+        rotation.rotation_lyapunov(BODY, "eight", R, Th, periods=1)

@@ -2,7 +2,7 @@
 
 import pytest
 
-from lib import report
+from lib.paper import report
 
 ITEMS = report.items()
 

@@ -3,7 +3,8 @@ import pytest
 
 from lib import control, trajectories as T
 from lib.params import Body, Gains
-from lib.simulate import SimulationError, simulate
+from lib.allocation import Limits
+from lib.simulate import Integration, SimulationError, simulate
 
 
 @pytest.mark.parametrize("ref", [T.circle(), T.eight()], ids=["circle", "eight"])
@@ -31,7 +32,7 @@ def test_default_initial_state_is_the_papers_table():
 
 
 def test_force_limit_is_respected_along_the_solution():
-    res = simulate(Body(), Gains(), T.eight(), 20.0, force_limit=4.0, rtol=1e-8, atol=1e-8)
+    res = simulate(Body(), Gains(), T.eight(), 20.0, limits=Limits(force=4.0), integration=Integration(rtol=1e-8, atol=1e-8))
     assert res.F.max() <= 4.0 and np.isclose(res.F.max(), 4.0)
 
 
@@ -67,8 +68,8 @@ def test_non_finite_solution_raises_naming_the_time():
     ({"t_end": np.nan}, ValueError, "t_end must be a positive"),
     ({"z0": [1.0, 2.0]}, ValueError, r"z0 must have shape \(3,\)"),
     ({"dz0": [0.0, np.nan, 0.0]}, ValueError, "dz0 must be finite"),
-    ({"force_limit": -1.0}, ValueError, "force_limit"),
-    ({"angle_limit": 7.0}, ValueError, "angle_limit"),
+    ({"limits": (4.0, 1.0)}, TypeError, "limits must be a lib.allocation.Limits"),
+    ({"integration": {"rtol": 1e-8}}, TypeError, "integration must be a lib.integrators.smooth.Integration"),
     ({"t_eval": [0.0, 2.0]}, ValueError, "t_eval"),
     ({"ref": "circle"}, TypeError, "ref must be a reference"),
     ({"body": None}, TypeError, "body must be"),
@@ -78,3 +79,16 @@ def test_simulate_rejects_bad_input(kw, exc, msg):
     args.update(kw)
     with pytest.raises(exc, match=msg):
         simulate(**args)
+
+
+@pytest.mark.parametrize("make,msg", [
+    (lambda: Limits(force=-1.0), "force_limit"),
+    (lambda: Limits(angle=7.0), "angle_limit"),
+    (lambda: Limits(force=np.nan), "force_limit"),
+    (lambda: Integration(rtol=0.0), "rtol"),
+    (lambda: Integration(atol=np.nan), "atol"),
+    (lambda: Integration(switching="magic"), "switching"),
+])
+def test_option_groups_reject_bad_values_on_construction(make, msg):
+    with pytest.raises(ValueError, match=msg):
+        make()

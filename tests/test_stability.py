@@ -83,7 +83,8 @@ def test_reduced_rotation_matches_full_closed_loop(kind, R, theta, dp0, dv0):
     z0 = ref.z(0.0) + np.array([0.0, 0.0, dp0])
     dz0 = ref.dz(0.0) + np.array([0.0, 0.0, dv0])
     # tight tolerances: at the default 1e-10 the full loop itself drifts by ~1e-7 in the slipping case
-    res = simulate.simulate(BODY, Gains(), ref, float(t[-1]), z0=z0, dz0=dz0, t_eval=t, rtol=1e-12, atol=1e-12)
+    res = simulate.simulate(BODY, Gains(), ref, float(t[-1]), z0=z0, dz0=dz0, t_eval=t,
+                            integration=simulate.Integration(rtol=1e-12, atol=1e-12))
     assert np.abs(res.error[:, :2]).max() < 1e-8          # the position stays on the reference
     np.testing.assert_allclose(res.rotation_error(), p, atol=1e-7)
 

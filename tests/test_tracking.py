@@ -5,7 +5,9 @@ import pytest
 from scipy.optimize import brentq
 
 from lib import control, model, tracking as TR, trajectories as T
+from lib.allocation import Limits
 from lib.params import Body, Gains
+from lib.simulate import Integration
 
 
 def _phi_accel_on_circle(body, gains, R, theta, p):
@@ -59,8 +61,8 @@ def test_eight_position_errors_follow_eq24_and_rotation_stays_bounded():
 
 def test_saturated_force_never_exceeds_cap():
     body, gains = Body(), Gains()
-    res = TR.run(body, gains, "eight", 2.0, math.pi / 4, 4, samples_per_period=100, force_limit=4.0,
-                 rtol=1e-8, atol=1e-8)
+    res = TR.run(body, gains, "eight", 2.0, math.pi / 4, 4, samples_per_period=100, limits=Limits(force=4.0),
+                 integration=Integration(rtol=1e-8, atol=1e-8))
     assert res.F.max() <= 4.0 + 1e-12
     iv = TR.saturated_intervals(res.t, res.F, 4.0)
     assert iv and all(b >= a for a, b in iv)

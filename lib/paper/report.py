@@ -20,6 +20,23 @@ from functools import lru_cache
 from typing import Callable
 
 import numpy as np
+import pandas as pd
+import sympy as sp
+
+from ..circle_rotation import (circle_critical_radius, circle_eigenvalues, circle_equilibria, circle_jacobian,
+                               circle_slipping_coexists)
+from ..allocation import Limits
+from ..control import allocate, allocate_least_squares, error_dynamics_solution
+from ..controllability import free_lie_rank, paper_bracket_count
+from ..limits import sweep_angle_limit
+from ..model import f, generalized_force
+from ..params import Body, Gains
+from ..rotation import eight_rotation_sweep
+from ..rotation_equations import derive_rotation_equation
+from ..simulate import Integration, open_loop_comparison, simulate
+from ..symbolic import derive_body_frame, rank_determinants
+from ..trajectories import circle, eight, eight_heading_fourier
+from .errata import rows
 
 __all__ = ["Outcome", "Item", "items", "table", "STATUSES"]
 
@@ -29,7 +46,6 @@ STATUSES = ("reproduced", "corrected", "not reproducible", "extended")
 @dataclass(frozen=True)
 class Outcome:
     """Result of a report check: the status, a figure of merit with its label, a note."""
-
     status: str
     merit: float
     merit_label: str
@@ -46,7 +62,6 @@ class Outcome:
 @dataclass(frozen=True)
 class Item:
     """A row of the report: the paper's item, where the book shows it, the expected status and its check."""
-
     key: str
     paper: str
     section: str
@@ -59,8 +74,6 @@ def _status(ok: bool, good: str, bad: str = "not reproducible") -> str:
 
 
 def _erratum(key: str):
-    from .errata import rows
-
     for r in rows():
         if r.key == key:
             return r
@@ -77,9 +90,6 @@ def _corrected_by(key: str, merit: float, merit_label: str, note: str = "") -> O
 
 @lru_cache(maxsize=1)
 def _open_loop_deviations() -> dict[str, float]:
-    from .params import Body
-    from .simulate import open_loop_comparison
-
     _, runs = open_loop_comparison(Body(), 20.0)
     return {k: float(np.abs(runs[k] - runs["config"]).max()) for k in ("state", "printed")}
 
@@ -91,10 +101,6 @@ def _check_config_form() -> Outcome:
 
 
 def _check_input_fields() -> Outcome:
-    import sympy as sp
-
-    from .symbolic import derive_body_frame
-
     sm = derive_body_frame()
     p = sm.params
     g1 = sp.Matrix([0, 0, 0, 1 / p["m"], 0, 0])
@@ -112,17 +118,10 @@ def _check_drift() -> Outcome:
 
 @lru_cache(maxsize=1)
 def _circle_run():
-    from .params import Body, Gains
-    from .simulate import simulate
-    from .trajectories import circle
-
     return simulate(Body(), Gains(), circle(), 60.0)
 
 
 def _check_eq24() -> Outcome:
-    from .control import error_dynamics_solution
-    from .params import Body, Gains
-
     res = _circle_run()
     exact = error_dynamics_solution(Body(), Gains(), res.error[0], res.derror[0], res.t)
     dev = float(np.abs(res.error[:, :2] - exact[:, :2]).max())
@@ -132,9 +131,6 @@ def _check_eq24() -> Outcome:
 
 
 def _check_allocation() -> Outcome:
-    from .control import allocate
-    from .model import generalized_force
-
     rng = np.random.default_rng(2014)
     tau, phi = rng.normal(scale=5.0, size=(10000, 3)), rng.uniform(-np.pi, np.pi, 10000)
     F, beta = allocate(tau, phi)
@@ -149,10 +145,6 @@ def _check_limits_29_30() -> Outcome:
 
 
 def _check_open_problem() -> Outcome:
-    from .control import allocate_least_squares
-    from .model import generalized_force
-    from .params import Body
-
     body = Body()
     rng = np.random.default_rng(7)
     tau, phi = rng.normal(scale=3.0, size=(200, 3)), rng.uniform(-np.pi, np.pi, 200)
@@ -171,8 +163,6 @@ def _check_open_problem() -> Outcome:
 # ------------------------------------------------------------------ Sec. 3
 
 def _corrected_group(prefix: str, merit_label: str) -> Outcome:
-    from .errata import rows
-
     group = [r for r in rows() if r.key.startswith(prefix)]
     verdicts = [r.check() for r in group]
     ok = bool(group) and all(v.confirmed for v in verdicts)
@@ -185,10 +175,6 @@ def _check_eq21() -> Outcome:
 
 
 def _check_rank_claim() -> Outcome:
-    import sympy as sp
-
-    from .symbolic import derive_body_frame, rank_determinants
-
     sm = derive_body_frame()
     p, (_, _, _, _, v2, w) = sm.params, sm.q
     det = rank_determinants(sm)["derived"]
@@ -204,9 +190,6 @@ def _check_thm6() -> Outcome:
 
 
 def _check_thm7() -> Outcome:
-    from .model import f
-    from .params import Body
-
     drift = float(np.linalg.norm(f(Body(), np.array([0.0, 0.0, 0.3, 1.0, 0.5, 0.2]))))
     return Outcome(_status(drift == 0.0, "reproduced"), drift,
                    "|f(q)| at a moving state: the drift is not zero",
@@ -219,8 +202,6 @@ def _check_conclusion() -> Outcome:
 
 
 def _check_count() -> Outcome:
-    from .controllability import free_lie_rank, paper_bracket_count
-
     printed, true = paper_bracket_count(2, 2), free_lie_rank(["f", "g1", "g2"], 2)
     return _corrected_by("sec3-bracket-count", float(printed - true),
                          "printed count minus independent brackets (w = 2, r = 2)")
@@ -229,8 +210,6 @@ def _check_count() -> Outcome:
 # ------------------------------------------------------------------ Secs. 4-5, figures
 
 def _check_eq27_28() -> Outcome:
-    from .trajectories import circle, eight
-
     t = np.linspace(0.0, 40.0, 4001)
     dev = 0.0
     for ref in (circle(), eight()):
@@ -242,9 +221,6 @@ def _check_eq27_28() -> Outcome:
 
 
 def _check_eq31() -> Outcome:
-    from .params import Body
-    from .stability import circle_equilibria
-
     p_end = float(_circle_run().rotation_error()[-1])
     dev = abs(p_end - circle_equilibria(Body(), 2.0, np.pi / 4)[0])
     return Outcome(_status(dev < 1e-6, "reproduced"), dev,
@@ -262,11 +238,7 @@ def _check_fig2() -> Outcome:
 
 @lru_cache(maxsize=1)
 def _eight_run():
-    from .params import Body, Gains
-    from .simulate import simulate
-    from .trajectories import eight
-
-    return simulate(Body(), Gains(), eight(), 80.0, rtol=1e-9, atol=1e-9)
+    return simulate(Body(), Gains(), eight(), 80.0, integration=Integration(rtol=1e-9, atol=1e-9))
 
 
 def _check_fig3() -> Outcome:
@@ -285,14 +257,11 @@ def _check_table() -> Outcome:
 
 
 def _check_fig4() -> Outcome:
-    from .params import Body, Gains
-    from .simulate import simulate
-    from .trajectories import eight
-
     ref = eight()
     T = ref.period
     t = np.linspace(0.0, 10 * T, 2001)
-    res = simulate(Body(), Gains(), ref, 10 * T, t_eval=t, force_limit=4.0, rtol=1e-9, atol=1e-9)
+    res = simulate(Body(), Gains(), ref, 10 * T, t_eval=t, limits=Limits(force=4.0),
+                   integration=Integration(rtol=1e-9, atol=1e-9))
     e = np.hypot(res.error[:, 0], res.error[:, 1])
     last, prev = e[-200:], e[-400:-200]
     amplitude, drift = float(last.max()), float(np.abs(last - prev).max())
@@ -303,10 +272,6 @@ def _check_fig4() -> Outcome:
 
 
 def _check_chaos() -> Outcome:
-    from .limits import sweep_angle_limit
-    from .params import Body, Gains
-    from .trajectories import eight
-
     reg = sweep_angle_limit(Body(), Gains(), eight(), np.radians([20.0]), n_transient=15, n_points=16,
                             n_lyap=48, rtol=1e-8, atol=1e-8)[0]
     # chaotic with a margin: twice the 3-standard-error threshold (measured 9-11 standard errors)
@@ -319,10 +284,6 @@ def _check_chaos() -> Outcome:
 # ------------------------------------------------------------------ Sec. 6
 
 def _check_eq32() -> Outcome:
-    import sympy as sp
-
-    from .stability import derive_rotation_equation
-
     eq = derive_rotation_equation()
     # autonomous in p on the circle, as (33) presumes, and with the paper's drag terms
     k = eq.params
@@ -341,9 +302,6 @@ def _check_p0() -> Outcome:
 
 
 def _check_eq34_35() -> Outcome:
-    from .params import Body
-    from .stability import circle_eigenvalues, circle_equilibria, circle_jacobian
-
     b = Body()
     dev = 0.0
     for R, th in ((2.0, np.pi / 4), (1.0, 0.3), (3.0, 1.2)):
@@ -357,9 +315,6 @@ def _check_eq34_35() -> Outcome:
 
 
 def _check_eq36() -> Outcome:
-    from .params import Body
-    from .stability import circle_critical_radius, circle_equilibria
-
     b, th = Body(), np.pi / 4
     Rc = b.c_phi / (b.a * np.sqrt(b.m**2 * th**2 + b.c**2))
     exists_above = np.isfinite(circle_equilibria(b, Rc * (1 + 1e-9), th)[0])
@@ -374,9 +329,6 @@ def _check_eq36() -> Outcome:
 
 
 def _check_gas() -> Outcome:
-    from .params import Body
-    from .stability import circle_critical_radius, circle_slipping_coexists
-
     b, th = Body(), 1.5
     ratio = 1.1
     coexists = bool(np.asarray(circle_slipping_coexists(b, ratio * circle_critical_radius(b, th), th)))
@@ -391,17 +343,12 @@ def _check_eq37() -> Outcome:
 
 
 def _check_fourier() -> Outcome:
-    from .stability import eight_heading_fourier
-
     a = eight_heading_fourier(3)
     return _corrected_by("fourier-a3", float(a[3]), "computed a3 (rad); printed -0.24",
                          "a1 and a5 are the computed ones rounded; a3 rounds to -0.23, not -0.24")
 
 
 def _check_fig5() -> Outcome:
-    from .params import Body
-    from .stability import eight_rotation_sweep
-
     R, Th = np.meshgrid(np.linspace(0.25, 4.0, 6), np.linspace(0.05, 1.5, 6))
     df = eight_rotation_sweep(Body(), R.ravel(), Th.ravel())
     lost = float(np.mean(df.regime != "periodic"))
@@ -464,8 +411,6 @@ def items() -> list[Item]:
 
 def table():
     """Run every check; the report as a pandas DataFrame."""
-    import pandas as pd
-
     records = []
     for it in items():
         out = it.check()

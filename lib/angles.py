@@ -1,0 +1,20 @@
+"""Angles: wrapping to one turn, and differences of states whose third entry is an angle."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["wrap_angle", "state_difference"]
+
+
+def wrap_angle(angle) -> np.ndarray:
+    """Wrap angles (rad) to the interval (-pi, pi]."""
+    angle = np.asarray(angle, dtype=float)
+    return np.pi - np.mod(np.pi - angle, 2 * np.pi)
+
+
+def state_difference(a, b) -> np.ndarray:
+    """a - b for states [x, y, phi, xdot, ydot, phidot] with the phi entry wrapped to (-pi, pi]."""
+    d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
+    d[..., 2] = wrap_angle(d[..., 2])
+    return d

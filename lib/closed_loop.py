@@ -1,0 +1,66 @@
+"""The closed loop: the body (2)-(4) driven by the computed-torque law (23) through an
+allocation (:mod:`lib.allocation`), as one vector field vectorised over points.
+
+This is the single closed-loop right-hand side behind the smooth integrator
+(:func:`lib.simulate.simulate`) and the batch integrator
+(:func:`lib.weighting.closed_loop_batch`); the switched integrator
+(:mod:`lib.integrators.switched`) uses a scalar fast path of the same equations,
+tested against this one at random states.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from .allocation import Allocation, Allocator, Limits
+from .control import computed_torque_from
+from .model import config_accel
+from .params import Body, Gains
+
+__all__ = ["ClosedLoop", "reference_of"]
+
+#: t -> (z_d, dz_d, ddz_d), each of shape (..., 3)
+Kinematics = Callable[[object], tuple]
+
+
+def reference_of(ref) -> Kinematics:
+    """The kinematics t -> (z_d, dz_d, ddz_d) of a reference object (:mod:`lib.trajectories`)."""
+    return lambda t: (ref.z(t), ref.dz(t), ref.ddz(t))
+
+
+@dataclass(frozen=True)
+class ClosedLoop:
+    """s' = (dz, ddz) with ddz from (2)-(4) under the inputs (F, beta) that ``allocate``
+    assigns to the demand (23) tracking ``kinematics``. Build it with :meth:`of`,
+    which validates the parts once; :meth:`rates` checks nothing, for loops."""
+
+    body: Body
+    gains: Gains
+    kinematics: Kinematics
+    allocate: Allocator
+
+    @classmethod
+    def of(cls, body: Body, gains: Gains, kinematics: Kinematics, allocation: Allocation | None = None,
+           limits: Limits | None = None) -> "ClosedLoop":
+        if not isinstance(gains, Gains):
+            raise TypeError(f"gains must be a lib.params.Gains, got {type(gains).__name__}")
+        allocation = Allocation() if allocation is None else allocation
+        if not isinstance(allocation, Allocation):
+            raise TypeError(f"allocation must be a lib.allocation.Allocation, got {type(allocation).__name__}")
+        return cls(body, gains, kinematics, allocation.bind(body, limits))
+
+    def inputs(self, t, z, dz):
+        """(tau, F, beta): the demand (23) and the allocated force (N) and angle (rad)."""
+        z_d, dz_d, ddz_d = self.kinematics(t)
+        tau = computed_torque_from(self.body, self.gains, z_d, dz_d, ddz_d, z, dz)
+        F, beta = self.allocate(tau, z[..., 2])
+        return tau, F, beta
+
+    def rates(self, t, s) -> tuple[np.ndarray, np.ndarray]:
+        """(s', F) for states s = [x, y, phi, xdot, ydot, phidot] of shape (..., 6)."""
+        z, dz = s[..., :3], s[..., 3:]
+        _, F, beta = self.inputs(t, z, dz)
+        return np.concatenate([dz, config_accel(self.body, z, dz, F, beta)], axis=-1), F

@@ -1,0 +1,51 @@
+"""Errata of the paper: one list of rows, each with the computation that proves it.
+
+A row is an :class:`Erratum`. Its ``check`` runs the computation and returns a
+:class:`Verdict`: whether the printed form holds (it must not) and whether the
+corrected form holds (it must). The errata page renders :func:`rows` with a
+live verdict and the test suite iterates the same list, so a row cannot exist
+without its check.
+
+Rows are grouped by the paper's sections in :mod:`.model_errata` (Secs. 2-3),
+:mod:`.tracking_errata` (Secs. 4-5) and :mod:`.rotation_errata` (Sec. 6), each
+importing the domain modules whose computations prove its rows; no domain
+module imports this subpackage.
+"""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from . import model_errata, rotation_errata, tracking_errata
+from .verdicts import Erratum, Verdict
+
+__all__ = ["Erratum", "Verdict", "rows", "table", "SOURCES"]
+
+#: the modules that contribute rows, in the order of the paper's sections
+SOURCES = (model_errata, tracking_errata, rotation_errata)
+
+
+def rows() -> list[Erratum]:
+    """All errata rows, collected from :data:`SOURCES` in order."""
+    out: list[Erratum] = []
+    for module in SOURCES:
+        out.extend(module.ROWS)
+    keys = [r.key for r in out]
+    dup = {k for k in keys if keys.count(k) > 1}
+    if dup:
+        raise RuntimeError(f"duplicate errata keys: {sorted(dup)}")
+    return out
+
+
+def table(run_checks: bool = True):
+    """The errata as a pandas DataFrame; with ``run_checks`` each row's verdict is computed."""
+    records = []
+    for r in rows():
+        rec = {"key": r.key, "where": r.where, "printed": r.printed, "corrected": r.corrected,
+               "verified by": r.verified_by, "section": r.section}
+        if run_checks:
+            v = r.check()
+            rec["confirmed"] = v.confirmed
+            rec["detail"] = v.detail
+        records.append(rec)
+    return pd.DataFrame.from_records(records)

@@ -1,0 +1,110 @@
+"""The layout of ``lib``: its import graph flows one way, the book's verdicts on the paper
+(``lib.paper``) sit on top, and modules import each other at module level."""
+
+import ast
+from graphlib import CycleError, TopologicalSorter
+from pathlib import Path
+
+import pytest
+
+LIB = Path(__file__).resolve().parents[1] / "lib"
+
+#: function-local imports of lib modules, each with the cost that justifies it
+LOCAL_IMPORTS_ALLOWED = {("lib.rotation", "lib.integrators.compiled")}  # numba's import and compile
+
+
+def _module_name(path: Path) -> str:
+    parts = path.relative_to(LIB.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _imports(path: Path):
+    """(imported lib module, whether the import is inside a function) for each import of lib."""
+    name = _module_name(path)
+    package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
+    tree = ast.parse(path.read_text())
+    local = {id(n) for f in ast.walk(tree) if isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef))
+             for n in ast.walk(f)}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")
+                base = base[: len(base) - node.level + 1]
+                mod = ".".join(base + ([node.module] if node.module else []))
+            else:
+                mod = node.module or ""
+            targets = [mod] if node.module else [f"{mod}.{a.name}" for a in node.names]
+            if node.module:  # "from .pkg import module" imports the module
+                targets += [f"{mod}.{a.name}" for a in node.names]
+        elif isinstance(node, ast.Import):
+            targets = [a.name for a in node.names]
+        else:
+            continue
+        for t in targets:
+            if t == "lib" or t.startswith("lib."):
+                yield t, id(node) in local
+
+
+def _graph():
+    """{module: set of lib modules it imports}, and the set of function-local (module, import) pairs."""
+    modules = {_module_name(p): p for p in LIB.rglob("*.py")}
+    g = {name: set() for name in modules}
+    local = set()
+    for name, path in modules.items():
+        for target, is_local in _imports(path):
+            if target in modules and target != name:
+                g[name].add(target)
+                if is_local:
+                    local.add((name, target))
+    return g, local
+
+
+def _descendants(g, node):
+    seen, todo = set(), [node]
+    while todo:
+        for nxt in g[todo.pop()] - seen:
+            seen.add(nxt)
+            todo.append(nxt)
+    return seen
+
+
+def test_import_graph_of_lib_is_acyclic():
+    g, _ = _graph()
+    try:
+        order = list(TopologicalSorter(g).static_order())
+    except CycleError as err:
+        pytest.fail(f"import cycle in lib: {err.args[1]}")
+    assert len(order) == len(g) > 30
+
+
+def test_domain_modules_never_import_the_verdicts_on_the_paper():
+    g, _ = _graph()
+    offenders = [(a, b) for a in g for b in g[a] if b.startswith("lib.paper") and not a.startswith("lib.paper")]
+    assert not offenders, offenders
+
+
+def test_lib_imports_its_own_modules_at_module_level_and_never_through_importlib():
+    _, local = _graph()
+    assert local <= LOCAL_IMPORTS_ALLOWED, sorted(local - LOCAL_IMPORTS_ALLOWED)
+    for path in LIB.rglob("*.py"):
+        assert "importlib" not in path.read_text(), path
+
+
+@pytest.mark.parametrize("core", ["lib.params", "lib.angles", "lib.model", "lib.trajectories", "lib.control",
+                                  "lib.allocation", "lib.closed_loop"])
+def test_the_model_core_depends_on_nothing_above_it(core):
+    # the core (params, model, trajectories, control, allocation, closed loop) never reaches up
+    # into the integrators, the analyses, the figures or the verdicts
+    g, _ = _graph()
+    below = {"lib", "lib.params", "lib.angles", "lib.model", "lib.trajectories", "lib.allocation", "lib.control",
+             "lib.closed_loop"}
+    assert _descendants(g, core) <= below, sorted(_descendants(g, core) - below)
+
+
+def test_the_parser_sees_relative_and_local_imports():
+    # the checks above are only as good as the parser: it must see a known edge of each kind
+    g, local = _graph()
+    assert "lib.integrators.switched" in g["lib.simulate"]        # from .integrators.switched import
+    assert "lib.trajectories" in g["lib.integrators.switched"]     # from ..trajectories import
+    assert "lib.paper.model_errata" in g["lib.paper.errata"]       # from . import model_errata
+    assert ("lib.rotation", "lib.integrators.compiled") in local
