@@ -107,24 +107,25 @@ class Eight(_Path):
         return self.z(t)[..., 2]
 
 
-def circle_position(R, theta, t) -> tuple:
+def circle_position(R, theta, t, cos=np.cos, sin=np.sin) -> tuple:
     """Position of the circle (27) and its first three time derivatives, as the tuple
     (x_d, y_d, vx_d, vy_d, ax_d, ay_d, jx_d, jy_d) (m, m/s, m/s^2, m/s^3).
 
-    The one definition of (27)'s position: written with numpy functions, so it takes
-    scalars (the switched integrator calls it per step) as well as arrays.
+    The one definition of (27)'s position, for arrays; with ``cos=math.cos,
+    sin=math.sin`` the same formulas run on Python floats at scalar speed (the
+    switched integrator calls them at every step, see :func:`position_kinematics`).
     """
     s = theta * t
-    c, sn = np.cos(s), np.sin(s)
+    c, sn = cos(s), sin(s)
     return (R * c, R * sn, -R * theta * sn, R * theta * c, -R * theta**2 * c, -R * theta**2 * sn,
             R * theta**3 * sn, -R * theta**3 * c)
 
 
-def eight_position(R, theta, t) -> tuple:
+def eight_position(R, theta, t, cos=np.cos, sin=np.sin) -> tuple:
     """Position of the eight (28), x_d = R/2 sin 2 theta t, y_d = R sin theta t, and its
     first three time derivatives, ordered as in :func:`circle_position`."""
     s = theta * t
-    c1, s1, c2, s2 = np.cos(s), np.sin(s), np.cos(2 * s), np.sin(2 * s)
+    c1, s1, c2, s2 = cos(s), sin(s), cos(2 * s), sin(2 * s)
     return (0.5 * R * s2, R * s1, R * theta * c2, R * theta * c1, -2 * R * theta**2 * s2, -R * theta**2 * s1,
             -4 * R * theta**3 * c2, -R * theta**3 * c1)
 
@@ -177,7 +178,7 @@ def position_kinematics(ref: Reference):
     another reference the jerk is a fourth-order central difference of ``ref.ddz``."""
     if isinstance(ref, _Path):
         position, R, th = POSITIONS[ref._kind], ref.R, ref.theta
-        return lambda t: position(R, th, t)
+        return lambda t: position(R, th, float(t), math.cos, math.sin)
 
     def kin(t: float) -> tuple:
         h = 1e-3

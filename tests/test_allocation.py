@@ -163,3 +163,31 @@ def test_simulate_runs_the_exact_limited_allocation_within_its_limits():
                    allocation=Allocation("limited", (1.0, 1.0, 0.1)), integration=Integration(rtol=1e-8, atol=1e-8))
     assert res.F.max() <= 4.0 + 1e-12 and np.abs(res.beta).max() <= 1.0 + 1e-12
     assert np.isclose(res.F.max(), 4.0)                      # the cap binds on this run
+
+
+@settings(max_examples=30, deadline=None)
+@given(tau=arrays(float, (7, 3), elements=st.floats(-20, 20)), phi=arrays(float, 7, elements=st.floats(-4, 4)),
+       law=st.sampled_from(["position", "least_squares", "limited"]))
+def test_bound_allocation_is_the_public_law(tau, phi, law):
+    # Allocation.bind validates once and returns the unvalidated kernel; it must compute
+    # exactly what the public, validating function computes
+    body, w, lim = Body(), (1.0, 1.0, 0.3), Limits(force=6.0, angle=2.0)
+    F, beta = Allocation(law, w).bind(body, lim)(tau, phi)
+    public = {"position": lambda: allocate(tau, phi, 6.0, 2.0),
+              "least_squares": lambda: allocate_least_squares(tau, phi, body, w, 6.0, 2.0),
+              "limited": lambda: allocate_limited(tau, phi, body, w, 6.0, 2.0)}[law]
+    np.testing.assert_array_equal(np.array([F, beta]), np.array(public()))
+
+
+@pytest.mark.parametrize("make,exc,msg", [
+    (lambda: Allocation("torque"), ValueError, "unknown allocation"),
+    (lambda: Allocation("least_squares", (1.0, -1.0, 0.0)), ValueError, "non-negative"),
+    (lambda: Allocation("least_squares", (0.0, 0.0, 0.0)), ValueError, "not all zero"),
+    (lambda: Allocation().bind("body"), TypeError, "body must be"),
+    (lambda: Allocation().bind(Body(), (4.0, 1.0)), TypeError, "limits must be"),
+    (lambda: Limits(force=0.0), ValueError, "force_limit"),
+    (lambda: Limits(angle=4.0), ValueError, "angle_limit"),
+])
+def test_allocation_and_limits_validate_on_construction(make, exc, msg):
+    with pytest.raises(exc, match=msg):
+        make()

@@ -57,7 +57,7 @@ def steps(rates: Rates, y0, t0: float, h: float, n_steps: int, tableau: Tableau 
     A, b, c = tableau.A, tableau.b, tableau.c
     hA, hb = h * A, h / tableau.b_den
     n_st = len(c)
-    y = np.asarray(y0, dtype=float)
+    y = np.asarray(y0, dtype=np.result_type(np.asarray(y0), float))
     for k in range(n_steps):
         t = t0 + k * h
         K = []
@@ -83,7 +83,7 @@ def integrate(rates: Rates, y0, t0: float, t_end: float, dt: float, tableau: Tab
     first point (index along the first axis) affected."""
     n_steps = int(np.ceil((t_end - t0) / dt))
     h = (t_end - t0) / n_steps
-    ts, ys = [t0], [np.array(y0, dtype=float)]
+    ts, ys = [t0], [np.array(y0, dtype=np.result_type(np.asarray(y0), float))]
     for k, (t, y) in enumerate(steps(rates, y0, t0, h, n_steps, tableau), start=1):
         if not np.all(np.isfinite(y)):
             bad = np.flatnonzero(~np.all(np.isfinite(y.reshape(y.shape[0], -1)), axis=1)) if y.ndim else [0]

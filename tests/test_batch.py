@@ -1,0 +1,46 @@
+"""The batch integrator (lib.integrators.batch): its schemes have their stated order and
+advance many points as one array."""
+
+import math
+
+import numpy as np
+import pytest
+
+from lib.integrators import batch
+
+
+def test_rk4_on_a_linear_equation_is_its_degree_4_taylor_polynomial_per_step():
+    lam = np.array([-1.0, -0.3 + 2.0j, 0.5])
+    h, n = 0.1, 37
+    _, y = batch.integrate(lambda t, y: lam * y, np.ones(3, complex), 0.0, n * h, h, batch.RK4)
+    z = lam * h
+    np.testing.assert_allclose(y[-1], (1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24) ** n, rtol=1e-13)
+
+
+@pytest.mark.parametrize("tableau,order", [(batch.RK4, 4), (batch.dop853(), 8)])
+def test_global_error_falls_with_the_order_of_the_scheme(tableau, order):
+    # y' = cos(t) y, y(0) = 1: y = exp(sin t); halving the step divides the error by 2^order
+    errors = []
+    for n in (8, 16):
+        _, y = batch.integrate(lambda t, y: math.cos(t) * y, np.ones(1), 0.0, 3.0, 3.0 / n, tableau)
+        errors.append(abs(y[-1, 0] - math.exp(math.sin(3.0))))
+    rate = math.log2(errors[0] / errors[1])
+    assert order - 0.6 < rate < order + 1.5, (errors, rate)
+
+
+def test_points_are_independent_rows():
+    # two points with their own parameter, integrated together, equal each run alone
+    k = np.array([[0.5], [2.0]])
+    rates = lambda t, y: -k * y + np.sin(t)  # noqa: E731
+    _, both = batch.integrate(rates, np.ones((2, 1)), 0.0, 2.0, 0.01, batch.RK4)
+    for i in range(2):
+        _, one = batch.integrate(lambda t, y, i=i: -k[i] * y + np.sin(t), np.ones(1), 0.0, 2.0, 0.01, batch.RK4)
+        np.testing.assert_array_equal(both[:, i], one)
+
+
+def test_recording_and_blow_up():
+    t, y = batch.integrate(lambda t, y: y, np.ones(1), 0.0, 1.0, 0.1, batch.RK4, record_every=3)
+    np.testing.assert_allclose(t, [0.0, 0.3, 0.6, 0.9, 1.0], atol=1e-12)
+    with pytest.raises(FloatingPointError, match="non-finite at t = .* for point 1"), np.errstate(over="ignore",
+                                                                                              invalid="ignore"):
+        batch.integrate(lambda t, y: np.array([[0.0], [1.0]]) * y**2, np.ones((2, 1)), 0.0, 5.0, 0.05)
