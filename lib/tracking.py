@@ -15,8 +15,10 @@ import numpy as np
 import pandas as pd
 from scipy.optimize import brentq
 
-from .allocation import Limits
+from .allocation import Allocation, Limits
 from .angles import wrap_angle
+from .closed_loop import ClosedLoop, reference_of
+from .integrators.smooth import integrate
 from .control import error_dynamics_solution
 from .params import Body, Gains
 from .simulate import Integration, SimulationResult, simulate
@@ -24,7 +26,7 @@ from .trajectories import Reference, make
 
 __all__ = [
     "run", "steady_mask", "restrict", "rotation_error_continuous", "position_deviation_from_eq24",
-    "steady_summary", "eight_sensitivity", "force_cap_sweep", "saturated_intervals",
+    "steady_summary", "refined_summary", "eight_sensitivity", "force_cap_sweep", "saturated_intervals",
     "circle_rotation_equilibrium",
 ]
 
@@ -82,6 +84,57 @@ def steady_summary(res: SimulationResult, n_periods: float = 2.0) -> dict:
     return {"p_min": float(p.min()), "p_max": float(p.max()), "p_range": float(p.max() - p.min()),
             "pos_err_max": float(e.max()), "F_min": float(res.F[mask].min()), "F_max": float(res.F[mask].max()),
             "F_mean": float(res.F[mask].mean())}
+
+
+def _parabola_extreme(y, i: int, sign: float) -> float:
+    """Extreme of the parabola through y[i-1], y[i], y[i+1] (y[i] at an end or without curvature)."""
+    if i == 0 or i == len(y) - 1:
+        return float(y[i])
+    ym, y0, yp = y[i - 1], y[i], y[i + 1]
+    curv = ym - 2 * y0 + yp
+    return float(y0 - (ym - yp) ** 2 / (8 * curv)) if sign * curv < 0 else float(y0)
+
+
+def refined_summary(body: Body, gains: Gains, res: SimulationResult, n_periods: float = 2.0, *,
+                    limits: Limits | None = None, allocation: Allocation | None = None,
+                    n_fine: int = 401) -> dict:
+    """:func:`steady_summary` with the extremes of the force F (N) and of the rotation error
+    p (rad) taken on the continuous signal, not on the samples: around each sampled extreme
+    the closed loop (:class:`lib.closed_loop.ClosedLoop`, with the ``limits`` and
+    ``allocation`` of the run) is integrated again from the sample before it to the sample
+    after it, at ``n_fine`` points and rtol = atol = 1e-12, and the extreme refined by the
+    parabola through the finest samples (error of order (h / n_fine)^3)."""
+    out = steady_summary(res, n_periods)
+    loop = ClosedLoop.of(body, gains, reference_of(res.ref), allocation, limits)
+    idx = np.flatnonzero(steady_mask(res, n_periods))
+    p = rotation_error_continuous(res)
+    shift = p - res.rotation_error()
+    tight = Integration(rtol=1e-12, atol=1e-12)
+
+    def fine(i):
+        """t, F and p on n_fine points between the samples beside sample i."""
+        a, b = max(i - 1, idx[0]), min(i + 1, idx[-1])
+        t0 = res.t[a]
+        tau = np.linspace(0.0, res.t[b] - t0, n_fine)
+        _, S = integrate(lambda t, s: loop.rates(t0 + t, s)[0], np.concatenate([res.z[a], res.dz[a]]),
+                         float(tau[-1]), tau, tight, ("x", "y", "phi", "xdot", "ydot", "phidot"))
+        t = t0 + tau
+        F = loop.inputs(t, S[:, :3], S[:, 3:])[1]
+        return F, S[:, 2] - res.ref.z(t)[:, 2] + shift[i]
+
+    for key, values, sign, pick in (("F_min", res.F, -1.0, 0), ("F_max", res.F, 1.0, 0),
+                                    ("p_min", p, -1.0, 1), ("p_max", p, 1.0, 1)):
+        v = sign * values[idx]
+        # every sampled local extreme close to the best one (one per period, say) is refined
+        local = np.flatnonzero((v >= np.roll(v, 1)) & (v >= np.roll(v, -1)))
+        near = local[v[local] >= v.max() - 0.01 * max(np.ptp(v), 1e-12)]
+        best = []
+        for i in idx[near]:
+            y = fine(i)[pick]
+            best.append(sign * _parabola_extreme(y, int(np.argmax(sign * y)), sign))
+        out[key] = sign * max(best)
+    out["p_range"] = out["p_max"] - out["p_min"]
+    return out
 
 
 def eight_sensitivity(body: Body, gains: Gains, Rs, thetas, *, n_periods: float = 12.0,
