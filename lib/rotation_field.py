@@ -17,7 +17,7 @@ import numpy as np
 
 from .params import Body
 
-__all__ = ["coefficients", "rotation_rates", "rotation_rates_dphi"]
+__all__ = ["coefficients", "rotation_rates", "rotation_rates_dphi", "rotation_rates_with_dphi"]
 
 
 def coefficients(body: Body, R, Theta):
@@ -38,3 +38,14 @@ def rotation_rates(phi, w, A, B, C, X1, Y1, X2, Y2):
 def rotation_rates_dphi(phi, B, C, X1, Y1, X2, Y2):
     """d w' / d phi of :func:`rotation_rates` (d w' / d w = -A), for the variational equation."""
     return -(B * Y1 + C * Y2) * np.sin(phi) - (B * X1 + C * X2) * np.cos(phi)
+
+
+def rotation_rates_with_dphi(phi, w, A, B, C, X1, Y1, X2, Y2):
+    """(phi', w', d w'/d phi): :func:`rotation_rates` and :func:`rotation_rates_dphi` at
+    once, sharing one cos and one sin, for the variational equation of the compiled
+    engine. The same operations in the same order, so the values are bit-identical to
+    the two definitions (``tests/test_rotation_verdicts.py`` checks it at random states)."""
+    cp, sp = np.cos(phi), np.sin(phi)
+    P = B * Y1 + C * Y2
+    Q = B * X1 + C * X2
+    return w, P * cp - Q * sp - A * w, -P * sp - Q * cp

@@ -11,9 +11,9 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ..rotation_field import rotation_rates
+from ..rotation_field import rotation_rates, rotation_rates_with_dphi
 
-__all__ = ["rotation_period"]
+__all__ = ["rotation_period", "rotation_flow"]
 
 _rates = numba.njit(rotation_rates)
 
@@ -50,3 +50,120 @@ def rotation_period(phi, w, A, B, C, h, X1, Y1, X2, Y2, hA, hB):
     _kernel(phi, w, np.ascontiguousarray(A, float), np.ascontiguousarray(B, float),
             np.ascontiguousarray(C, float), X1, Y1, X2, Y2, hA, hB, out, out_w)
     return (out, out_w), phi, w
+
+
+# ---------------------------------------------------------------- the period map with its Jacobian
+
+_rates_jac = numba.njit(rotation_rates_with_dphi)
+
+
+@numba.njit(cache=True, parallel=True)
+def _flow_kernel(phi, w, J, A, B, C, periods, X1, Y1, X2, Y2, hA, hB, jac, renorm, track, H, wind2pi,
+                 logs, sec, pmin, pmax):
+    """``periods[q]`` periods for point q of (phi, w) and, with ``jac``, of the variational
+    matrix J[q] = (V00, V01, V10, V11), V = d(phi, w) / d(phi0, w0), by the same stages.
+    With ``renorm`` only the first column of V is carried: a tangent vector, renormalised
+    after every period, the log of its growth stored in logs[period, q]. The states at the
+    end of every period go to sec[period, q] (raw phi, w); with ``track`` pmin/pmax hold the
+    extremes of p = phi - H - wind2pi * period over every step end."""
+    n, stages = X1.shape
+    full = jac and not renorm
+    for q in numba.prange(phi.size):
+        kp = np.empty(stages)
+        kw = np.empty(stages)
+        k0 = np.empty(stages)
+        k1 = np.empty(stages)
+        k2 = np.empty(stages)
+        k3 = np.empty(stages)
+        f, v, a_, b_, c_ = phi[q], w[q], A[q], B[q], C[q]
+        j0, j1, j2, j3 = J[q, 0], J[q, 1], J[q, 2], J[q, 3]
+        lo, hi = pmin[q], pmax[q]
+        for per in range(periods[q]):
+            for j in range(n):
+                for i in range(stages):
+                    ps, ws = f, v
+                    s0, s1, s2, s3 = j0, j1, j2, j3
+                    for l in range(i):
+                        c = hA[i, l]
+                        ps += c * kp[l]
+                        ws += c * kw[l]
+                        if jac:
+                            s0 += c * k0[l]
+                            s2 += c * k2[l]
+                            if full:
+                                s1 += c * k1[l]
+                                s3 += c * k3[l]
+                    if jac:
+                        kp[i], kw[i], d = _rates_jac(ps, ws, a_, b_, c_, X1[j, i], Y1[j, i], X2[j, i], Y2[j, i])
+                        k0[i] = s2
+                        k2[i] = d * s0 - a_ * s2
+                        if full:
+                            k1[i] = s3
+                            k3[i] = d * s1 - a_ * s3
+                    else:
+                        kp[i], kw[i] = _rates(ps, ws, a_, b_, c_, X1[j, i], Y1[j, i], X2[j, i], Y2[j, i])
+                for i in range(stages):
+                    f += hB[i] * kp[i]
+                    v += hB[i] * kw[i]
+                if jac:
+                    for i in range(stages):
+                        j0 += hB[i] * k0[i]
+                        j2 += hB[i] * k2[i]
+                        if full:
+                            j1 += hB[i] * k1[i]
+                            j3 += hB[i] * k3[i]
+                if track:
+                    p = f - H[j] - wind2pi * per
+                    lo = min(lo, p)
+                    hi = max(hi, p)
+            sec[per, q, 0] = f
+            sec[per, q, 1] = v
+            if renorm:
+                norm = np.sqrt(j0 * j0 + j2 * j2)
+                logs[per, q] = np.log(norm)
+                j0 /= norm
+                j2 /= norm
+        phi[q], w[q] = f, v
+        J[q, 0], J[q, 1], J[q, 2], J[q, 3] = j0, j1, j2, j3
+        pmin[q], pmax[q] = lo, hi
+
+
+def rotation_flow(phi, w, A, B, C, periods, X1, Y1, X2, Y2, hA, hB, *, J=None, jac: bool = True,
+                  renorm: bool = False, H=None, wind2pi: float = 0.0):
+    """``periods`` (int, or one per point) reference periods of the reduced rotation
+    equation (32) in the phase form of :func:`lib.rotation_field.rotation_rates`, for N
+    points in parallel, by the fixed-step scheme of :func:`rotation_period` (the unit
+    reference's derivatives tabulated at the stage phases, (n steps, stages); ``hA``,
+    ``hB`` the tableau times the step). With ``jac`` the variational equation (its
+    phi-derivative from :func:`lib.rotation_field.rotation_rates_with_dphi`) is run with the
+    same stages, so J is the exact Jacobian of the discrete map. ``J`` (N, 2, 2) is the
+    initial variational matrix (identity by default). With ``renorm`` its first column
+    is a tangent vector renormalised every period (for the largest Lyapunov exponent); the
+    second column is then not integrated (returned as given).
+    With ``H`` (n,), the reference heading at the step ends (rad), the extremes of
+    p = phi - phi_d over every step are tracked (the heading winds ``wind2pi`` rad per period).
+
+    Returns a dict: phi, w (N,) final; J (N, 2, 2); sec (P, N, 2) the raw (phi, w) at the end
+    of each period (P = max periods; NaN past a point's own count); logs (P, N) the log
+    growth of the tangent vector per period (with ``renorm``); pmin, pmax (N,) (with ``H``)."""
+    phi = np.array(phi, dtype=float, ndmin=1)
+    w = np.array(w, dtype=float, ndmin=1)
+    N = phi.size
+    per = np.broadcast_to(np.asarray(periods, dtype=np.int64), (N,)).copy()
+    P = int(per.max()) if N else 0
+    Jf = np.tile(np.array([1.0, 0.0, 0.0, 1.0]), (N, 1)) if J is None else \
+        np.ascontiguousarray(np.asarray(J, dtype=float).reshape(N, 4))
+    if renorm:
+        Jf[:, 1] = 0.0
+        Jf[:, 3] = 0.0
+    logs = np.full((P if renorm else 1, N), np.nan)
+    sec = np.full((P, N, 2), np.nan)
+    track = H is not None
+    Hc = np.zeros(X1.shape[0]) if H is None else np.ascontiguousarray(H, dtype=float)
+    pmin = np.full(N, np.inf)
+    pmax = np.full(N, -np.inf)
+    _flow_kernel(phi, w, Jf, np.ascontiguousarray(A, float), np.ascontiguousarray(B, float),
+                 np.ascontiguousarray(C, float), per, X1, Y1, X2, Y2, hA, hB, bool(jac or renorm),
+                 bool(renorm), track, Hc, float(wind2pi), logs, sec, pmin, pmax)
+    return dict(phi=phi, w=w, J=Jf.reshape(N, 2, 2), sec=sec, logs=logs if renorm else None,
+                pmin=pmin if track else None, pmax=pmax if track else None)
