@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import matplotlib.pyplot as plt
-from matplotlib.patches import FancyArrowPatch, Polygon
+from matplotlib.colors import ListedColormap, LogNorm
+from matplotlib.patches import FancyArrowPatch, Patch, Polygon
 
 import pandas as pd
 
@@ -13,7 +14,8 @@ from .circle_rotation import circle_critical_radius
 from .params import Body
 
 __all__ = ["body_outline", "draw_body", "new_axes", "plot_path", "plot_errors", "plot_force", "plot_bifurcation",
-           "plot_section", "plot_fig5", "plot_circle_map"]
+           "plot_section", "plot_fig5", "plot_fig5_exponents", "plot_circle_map", "plot_heading_orbits",
+           "REGIME_COLORS"]
 
 
 def new_axes(ax=None, **subplot_kw):
@@ -130,22 +132,69 @@ def plot_section(section, i: int = 0, j: int = 4, *, ax=None, color: str = "k", 
     return fig
 
 
+#: how each non-periodic regime of :func:`lib.rotation.rotation_verdicts` is drawn on the maps
+REGIME_COLORS = {"slipping": "C3", "chaotic": "0.15", "quasiperiodic": "C0", "undecided": "0.7"}
+
+
+def _grid(frame: pd.DataFrame, column: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(R, Theta, values) of a sweep on a rectangular grid, values (n_Theta, n_R)."""
+    table = frame.pivot_table(index="Theta", columns="R", values=column, aggfunc="first", dropna=False)
+    return table.columns.to_numpy(float), table.index.to_numpy(float), table.to_numpy(float)
+
+
+def _cells(R: np.ndarray, Th: np.ndarray):
+    """Cell edges for pcolormesh around grid centres."""
+    def edges(v):
+        mid = (v[1:] + v[:-1]) / 2
+        return np.concatenate([[v[0] - (mid[0] - v[0])], mid, [v[-1] + (v[-1] - mid[-1])]])
+    return edges(R), edges(Th)
+
+
 def plot_fig5(frame: pd.DataFrame, ax=None):
-    """Fig. 5: steady-state range (rad) of the rotation error over (R, Theta), one
-    square per periodic point; slipping points as empty circles, irregular as crosses.
-    Returns the figure."""
-    if ax is None:
-        fig, ax = plt.subplots(figsize=(7, 5))
-    fig = ax.figure
-    per = frame[frame.regime == "periodic"]
-    sc = ax.scatter(per.R, per.Theta, c=per["range"], marker="s", s=22, cmap="viridis", linewidths=0)
-    fig.colorbar(sc, ax=ax, label="range of $p$ (rad)")
-    slip = frame[frame.regime == "slipping"]
-    ax.scatter(slip.R, slip.Theta, facecolors="none", edgecolors="C3", s=30, label="slipping")
-    irr = frame[frame.regime == "irregular"]
-    ax.scatter(irr.R, irr.Theta, marker="x", color="k", s=14, lw=0.8, label="irregular")
+    """Fig. 5: range (rad) of the rotation error over the attracting orbit at the periodic
+    points of a rectangular (R, Theta) grid (:func:`lib.rotation.rotation_verdicts`), the
+    other regimes in flat colours (:data:`REGIME_COLORS`), and the points where stability
+    is lost (column ``lost``) ringed, as the paper's empty circles. Returns the figure."""
+    fig, ax = new_axes(ax, figsize=(7, 5))
+    R, Th, rng = _grid(frame, "range")
+    _, _, per = _grid(frame.assign(is_per=(frame.regime == "periodic").astype(float)), "is_per")
+    Re, Te = _cells(R, Th)
+    mesh = ax.pcolormesh(Re, Te, np.ma.masked_where(per != 1.0, rng), cmap="viridis", norm=LogNorm(), shading="flat")
+    fig.colorbar(mesh, ax=ax, label="range of $p$ on the orbit (rad, log scale)")
+    handles = []
+    for regime, color in REGIME_COLORS.items():
+        _, _, sel = _grid(frame.assign(sel=(frame.regime == regime).astype(float)), "sel")
+        if np.any(sel == 1.0):
+            ax.pcolormesh(Re, Te, np.ma.masked_where(sel != 1.0, sel), cmap=ListedColormap([color]),
+                          shading="flat")
+            handles.append(Patch(color=color, label=f"{regime} ({int(np.sum(sel == 1.0))})"))
+    lost = frame[frame.lost]
+    handles.append(ax.scatter(lost.R, lost.Theta, s=10, facecolors="none", edgecolors="w", linewidths=0.6,
+                              label=f"lost ({len(lost)})"))
     ax.set(xlabel="R (m)", ylabel=r"$\Theta$ (rad/s)")
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2)
+    ax.set_facecolor("0.5")
+    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=3, fontsize=8)
+    return fig
+
+
+def plot_fig5_exponents(frame: pd.DataFrame):
+    """Beside Fig. 5: the largest Floquet multiplier modulus of the attracting orbit
+    (periodic and slipping points) and the largest Lyapunov exponent (1/s) of the
+    other points, on the same (R, Theta) grid. Returns the figure."""
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.4), sharey=True, layout="constrained")
+    R, Th, flo = _grid(frame, "floquet")
+    _, _, lya = _grid(frame.assign(ly=np.where(frame.regime.isin(["periodic", "slipping"]), np.nan, frame.lyapunov)),
+                      "ly")
+    Re, Te = _cells(R, Th)
+    m1 = a1.pcolormesh(Re, Te, np.ma.masked_invalid(flo), cmap="magma", vmin=0, vmax=1, shading="flat")
+    fig.colorbar(m1, ax=a1, label=r"largest Floquet modulus $|\mu_1|$")
+    lim = np.nanmax(np.abs(lya)) if np.isfinite(lya).any() else 1.0
+    m2 = a2.pcolormesh(Re, Te, np.ma.masked_invalid(lya), cmap="coolwarm", vmin=-lim, vmax=lim, shading="flat")
+    fig.colorbar(m2, ax=a2, label=r"largest Lyapunov exponent $\lambda_1$ (1/s)")
+    for ax, title in ((a1, "attracting orbits"), (a2, "no attracting orbit reached")):
+        ax.set(xlabel="R (m)", title=title)
+        ax.set_facecolor("0.85")
+    a1.set_ylabel(r"$\Theta$ (rad/s)")
     return fig
 
 
@@ -168,3 +217,31 @@ def plot_circle_map(frame: pd.DataFrame, body: Body, coexists=None, ax=None):
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2, fontsize=8)
     return ax.figure
 
+
+
+def plot_heading_orbits(orbits: dict, t, p, distances: dict, multiplier: float):
+    """The eight's heading error against its attracting orbits: (a) each orbit's p over
+    one period (``orbits``: label -> :class:`lib.rotation.RotationAttractor`) with the
+    run's last period (t (s), p (rad)) on top; (b) the run's distance to each orbit per
+    period (``distances``: label -> array, from ``distance_per_period``) on a log scale,
+    with the rate |mu_1|^j of the slowest Floquet multiplier ``multiplier``. Returns the figure."""
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2), layout="constrained")
+    for i, (label, orb) in enumerate(orbits.items()):
+        a.plot(orb.t, orb.p, color=f"C{i}", lw=2, label=f"orbit {label}")
+    T = float(next(iter(orbits.values())).t[-1])
+    last = t >= t[-1] - T - 1e-9
+    tl, pl = np.mod(t[last], T), p[last]
+    near = min(orbits.values(), key=lambda o: np.abs(np.angle(np.exp(1j * (pl - np.interp(tl, o.t, o.p))))).max())
+    pl = pl - 2 * np.pi * np.round(np.mean(pl - np.interp(tl, near.t, near.p)) / (2 * np.pi))
+    a.plot(tl, pl, "k.", ms=2, label="run from the Table's start, last period")
+    a.set(xlabel="time within the period (s)", ylabel="$p$ (rad)", title="(a)")
+    a.legend(fontsize=8)
+    for i, (label, d) in enumerate(distances.items()):
+        j = np.arange(d.size)
+        b.semilogy(j, d, "o-", ms=3, color=f"C{i}", label=f"distance to orbit {label}")
+    d_last = min(distances.values(), key=lambda d: d[-1])
+    j = np.arange(d_last.size)
+    b.semilogy(j, d_last[-1] * multiplier ** (j - j[-1]), "k:", label=r"$|\mu_1|^j$")
+    b.set(xlabel="period $j$", ylabel="largest $|p - p_{orbit}|$ over the period (rad)", title="(b)")
+    b.legend(fontsize=8)
+    return fig

@@ -6,13 +6,17 @@ names Chapter 5 and other code use, gathered from where each is defined.
 * :mod:`lib.rotation_field`: (32) in the phase s = Theta t, the field the integrators run;
 * :mod:`lib.rotation`: the reduced rotation for many (R, Theta) at once, the Fig. 5 sweep,
   periodic orbits and Lyapunov exponents;
+* :mod:`lib.rotation_verdicts`: the decisive verdicts of Fig. 5 (orbits, Floquet multipliers,
+  Lyapunov exponents, drift) and the attracting orbits of one point;
 * :mod:`lib.trajectories`: the Fourier series of the eight's tangent angle.
 """
 
 from .circle_rotation import (circle_critical_radius, circle_eigenvalues, circle_equilibria, circle_final_state,
                               circle_jacobian, circle_rotation_rhs, circle_slipping_coexists)
-from .rotation import (ENGINES, classify_samples, eight_rotation_sweep, reduced_rotation, rotation_sweep,
-                       sampled_range, steps_per_period)
+from .rotation import (ENGINES, classify_samples, reduced_rotation, rotation_sweep, sampled_range,
+                       steps_per_period)
+from .rotation_verdicts import (REGIMES, MapSummary, RotationAttractor, eight_rotation_sweep, map_summary,
+                               rotation_attractor, rotation_verdicts)
 from .rotation_equations import (RotationEquation, corrected_p0, derive_eight_equation, derive_rotation_equation,
                                  printed_eq33, printed_eq37, printed_p0)
 from .trajectories import PAPER_HEADING_SERIES, eight_heading_fourier, heading_series
@@ -22,5 +26,6 @@ __all__ = [
     "corrected_p0", "printed_p0", "circle_equilibria", "circle_critical_radius", "circle_eigenvalues",
     "circle_jacobian", "circle_rotation_rhs", "circle_final_state", "circle_slipping_coexists",
     "steps_per_period", "reduced_rotation", "classify_samples", "sampled_range", "rotation_sweep",
-    "eight_rotation_sweep", "ENGINES", "eight_heading_fourier", "heading_series", "PAPER_HEADING_SERIES",
+    "eight_rotation_sweep", "REGIMES", "rotation_verdicts", "rotation_attractor", "RotationAttractor",
+    "map_summary", "MapSummary", "ENGINES", "eight_heading_fourier", "heading_series", "PAPER_HEADING_SERIES",
 ]

@@ -24,7 +24,7 @@ from .closed_loop import ClosedLoop
 from .integrators import batch
 from .params import Body, Gains
 from .robustness import perturbed
-from .rotation import eight_rotation_sweep
+from .rotation_verdicts import eight_rotation_sweep
 from .trajectories import KINEMATICS
 
 __all__ = ["BatchResult", "closed_loop_batch", "steady_metrics", "MapComparison", "compare_on_map"]
@@ -153,8 +153,9 @@ def steady_metrics(res: BatchResult, n_periods: float = 2.0) -> pd.DataFrame:
 class MapComparison:
     """The two laws on a set of (R, Theta) points of the eight, from one start.
 
-    ``lost`` (N,) bool: the paper's law does not settle to a periodic heading
-    (Chapter 5's classification, :func:`lib.rotation.eight_rotation_sweep`);
+    ``lost`` (N,) bool: the paper's law reaches no attracting periodic orbit of the
+    heading (regime other than ``periodic`` in Chapter 5's verdicts,
+    :func:`lib.rotation_verdicts.eight_rotation_sweep`: the broad reading of "lost");
     ``held`` (N,) bool: under the weighted law the heading does not slip over the
     last period and the body stays on the path (:func:`steady_metrics`);
     ``pos_rms`` (N,) the weighted law's steady position error (m RMS).
