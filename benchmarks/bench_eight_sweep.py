@@ -2,7 +2,7 @@
 
 Run with ``make benchmark`` (or ``.venv/bin/python benchmarks/bench_eight_sweep.py``).
 
-Fast: :func:`lib.stability.eight_rotation_sweep` (:func:`lib.rotation.rotation_verdicts`:
+Fast: :func:`lib.stability.eight_rotation_sweep` (:func:`lib.rotation_verdicts.rotation_verdicts`:
 Newton on the compiled period map, Lyapunov exponents for the rest) on the 100 x 100
 grid R in [0.25, 4] m, Theta in [0.05, 1.5] rad/s, timed after one warm-up call that
 compiles the kernels (cached on disk); its time per grid point is total / 10000.
@@ -10,7 +10,7 @@ Target: <= 60 s.
 Reference, per point, on a random sample: :func:`lib.simulate.simulate` (DOP853,
 rtol = atol = 1e-10) on the full 6-state closed loop (2)-(4), (23), (25)-(26), started
 on the reference, for the periods the fast verdict integrated plus 24, at least 48 and
-at most ``--periods`` (200), its verdict decided from its last nine periods: periodic
+at most ``--periods`` (200), its verdict decided from its last ten periods: periodic
 (or slipping) when the last periods repeat within 1e-6 rad at some lag k <= 8 (up to
 whole turns), otherwise irregular; the range over the last k periods from samples at
 the sweep's phases with the same Hermite refinement of the extremes.
@@ -37,7 +37,7 @@ def reference_verdict(body: Body, R: float, Theta: float, steps: int, periods: i
     """(verdict, period, slip (turns per period), range (rad)) of the full closed loop by solve_ivp."""
     ref = trajectories.eight(R, Theta)
     T = 2 * math.pi / Theta
-    last = max_lag + 1
+    last = max_lag + 2
     t_eval = T * (periods - last) + T * np.arange(1, last * steps + 1) / steps
     res = simulate.simulate(body, Gains(), ref, float(t_eval[-1]), z0=ref.z(0.0), dz0=ref.dz(0.0), t_eval=t_eval)
     p = res.rotation_error().reshape(last, steps)
@@ -46,8 +46,13 @@ def reference_verdict(body: Body, R: float, Theta: float, steps: int, periods: i
         d = p[-1] - p[-1 - k]
         n = round(d[-1] / (2 * math.pi))
         if np.abs(d - 2 * math.pi * n).max() <= tol:
-            rng = stability.sampled_range(p[-k:].ravel()[None], cyclic=(n == 0), dy=dp[-k:].ravel()[None],
-                                          h=2 * math.pi / steps)[0]
+            if n == 0:      # whole periods of a periodic signal wrap around
+                rng = stability.sampled_range(p[-k:].ravel()[None], cyclic=True, dy=dp[-k:].ravel()[None],
+                                              h=2 * math.pi / steps)[0]
+            else:           # a slipping orbit over [0, kT]: its start is a sample too
+                y = np.concatenate([p[-k - 1, -1:], p[-k:].ravel()])
+                dy = np.concatenate([dp[-k - 1, -1:], dp[-k:].ravel()])
+                rng = stability.sampled_range(y[None], cyclic=False, dy=dy[None], h=2 * math.pi / steps)[0]
             return ("periodic" if n == 0 else "slipping"), k, n / k, float(rng)
     return "irregular", 0, float((p[-1, -1] - p[0, -1]) / (2 * math.pi * max_lag)), float(np.ptp(p))
 
@@ -85,7 +90,8 @@ def main() -> None:
         verdict, k, slip, r_ref = reference_verdict(body, row.R, row.Theta, int(row.steps), periods)
         times.append(time.perf_counter() - t0)
         fast_orbit = row.regime in ("periodic", "slipping")
-        same = (verdict == row.regime and k == row.period) if fast_orbit else verdict == "irregular"
+        same = (verdict == row.regime and k == row.period and abs(slip - row.slip) < 1e-9) if fast_orbit \
+            else verdict == "irregular"
         agree.append(same)
         if same and fast_orbit:
             diffs.append(abs(r_ref - row["range"]))

@@ -173,7 +173,7 @@ def plot_fig5(frame: pd.DataFrame, ax=None):
                               label=f"lost ({len(lost)})"))
     ax.set(xlabel="R (m)", ylabel=r"$\Theta$ (rad/s)")
     ax.set_facecolor("0.5")
-    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=3, fontsize=8)
+    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=3, fontsize=8, facecolor="0.75")
     return fig
 
 

@@ -73,7 +73,7 @@ class _Engine:
         tab = batch.dop853()
         self.hA, self.hB = tab.A * self.h, tab.b * self.h
         self.w2pi = 2 * np.pi * self.winding
-        self.H0 = _shape(kind)[0](0.0)[4]
+        self.H0, self.H1_0 = _shape(kind)[0](0.0)[4:6]
 
     def flow(self, phi, w, A, B, C, periods, *, jac=False, renorm=False, track=False):
         H = self.H if track else None
@@ -403,7 +403,8 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
 
     Returns a DataFrame, one row per point, in order: R (m), Theta (rad/s), regime;
     period (reference periods of the orbit, periodic/slipping; 0 otherwise); range (rad:
-    max - min of p over the attracting orbit at every step, extremes refined by cubic
+    max - min of p over the attracting orbit at every step (a slipping one over the k
+    periods from its point at s = 0, where p runs on by 2 pi n), extremes refined by cubic
     Hermite interpolation (:func:`sampled_range`); over the Lyapunov run otherwise);
     floquet (largest multiplier modulus); lyapunov, lyapunov_stderr (1/s; for an orbit
     ln|mu_1| / (k T) with no error); slip, slip_stderr (turns of p per period: n / k on
@@ -636,8 +637,24 @@ def _verdict_core(body, kind, R, Theta, p0, v0, n_pts, opts, engine, n_fine=None
                 out["lyapunov"][g] = np.log(mod) * Theta[g] / (2 * np.pi * kk)
                 if g.size == 0:
                     continue
-            p, dp = eng.record(out["x"][g, 0], out["x"][g, 1], A, B, C, int(k))
-            out["range"][g] = sampled_range(p, cyclic=slip_n[g] == 0, dy=dp, h=eng.h)
+            out["range"][g] = _orbit_range(eng, out["x"][g], A, B, C, int(k), slip_n[g])
+    return out
+
+
+def _orbit_range(eng: _Engine, x, A, B, C, k: int, slip) -> np.ndarray:
+    """Range (rad) of p over k periods from the orbit points x (N, 2), sampled at every
+    step, the extremes refined by cubic Hermite interpolation. A periodic orbit's samples
+    wrap around (p(kT) = p(0)); a slipping orbit's window [0, kT] includes its start, where
+    its extreme often lies (p runs on by 2 pi n)."""
+    p, dp = eng.record(x[:, 0], x[:, 1], A, B, C, k)
+    out = np.empty(x.shape[0])
+    cyc = np.asarray(slip) == 0
+    if cyc.any():
+        out[cyc] = sampled_range(p[cyc], cyclic=True, dy=dp[cyc], h=eng.h)
+    if (~cyc).any():
+        p0, dp0 = x[~cyc, 0] - eng.H0, x[~cyc, 1] - eng.H1_0
+        out[~cyc] = sampled_range(np.column_stack([p0, p[~cyc]]), cyclic=False,
+                                  dy=np.column_stack([dp0, dp[~cyc]]), h=eng.h)
     return out
 
 

@@ -141,13 +141,19 @@ def eight_sensitivity(body: Body, gains: Gains, Rs, thetas, *, n_periods: float 
                       n_steady: float = 2.0) -> pd.DataFrame:
     """Steady-state measures of eight tracking (:func:`steady_summary`) over a grid of
     radii R (m) and rates theta (rad/s); one row per (R, theta). A run whose rotation
-    does not settle to a periodic motion shows a large ``p_range``."""
+    does not settle to a periodic motion shows a large ``p_range``. The run's end state
+    is returned too, so that a verdict can continue it: ``p_end`` (rad, in (-pi, pi]),
+    ``dp_end`` (rad/s), the heading error and its rate, and ``e_end`` (m), the largest
+    position error (the reduced rotation equation holds once it is negligible)."""
     rows = []
     for R in np.atleast_1d(Rs):
         for th in np.atleast_1d(thetas):
             res = run(body, gains, "eight", float(R), float(th), n_periods, samples_per_period=100,
                       integration=Integration(rtol=1e-9, atol=1e-9))
-            rows.append({"R": float(R), "theta": float(th), **steady_summary(res, n_steady)})
+            rows.append({"R": float(R), "theta": float(th), **steady_summary(res, n_steady),
+                         "p_end": float(wrap_angle(res.rotation_error()[-1])),
+                         "dp_end": float(res.dz[-1, 2] - res.dz_d[-1, 2]),
+                         "e_end": float(np.abs(res.error[-1, :2]).max())})
     return pd.DataFrame(rows)
 
 
