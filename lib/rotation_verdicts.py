@@ -416,7 +416,9 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
     Lyapunov run; a periodic orbit is never lost, whatever its range (it repeats), nor is
     a motion without an orbit that stays within one turn; orbit_p (rad, p at s = 0 mod 2 pi at the orbit point the run
     is nearest to: which orbit is reached), distance (rad, from the run's last state to
-    that point), residual (rad, Newton's), periods (integrated), steps (per period of the fine map), verdict_steps (of the verdict map),
+    that point), residual (rad, Newton's), mirror (rad, on the eight: the distance from
+    the orbit to its mirror image, 0 for a symmetric orbit; a positive one coexists with
+    its mirror image, a second attractor), periods (integrated), steps (per period of the fine map), verdict_steps (of the verdict map),
     reason (why undecided).
     """
     if kind not in ("eight", "circle"):
@@ -464,7 +466,7 @@ def _verdict_core(body, kind, R, Theta, p0, v0, n_pts, opts, engine, n_fine=None
                floquet=np.full(N, np.nan), lyapunov=np.full(N, np.nan), lyapunov_stderr=np.full(N, np.nan),
                slip=np.full(N, np.nan), slip_stderr=np.full(N, np.nan), lost=np.zeros(N, bool),
                orbit_p=np.full(N, np.nan), distance=np.full(N, np.nan), residual=np.full(N, np.nan),
-               periods=np.zeros(N, int), reason=np.full(N, "", dtype=object),
+               mirror=np.full(N, np.nan), periods=np.zeros(N, int), reason=np.full(N, "", dtype=object),
                x=np.full((N, 2), np.nan), mult=np.full((N, 2), np.nan + 0j))
     slip_n = np.zeros(N, int)
     HL = 2 * opts["max_period"] + 1         # section states kept for the candidates and the reach test
@@ -637,17 +639,30 @@ def _verdict_core(body, kind, R, Theta, p0, v0, n_pts, opts, engine, n_fine=None
                 out["lyapunov"][g] = np.log(mod) * Theta[g] / (2 * np.pi * kk)
                 if g.size == 0:
                     continue
-            out["range"][g] = _orbit_range(eng, out["x"][g], A, B, C, int(k), slip_n[g])
+            out["range"][g], out["mirror"][g] = _orbit_range(eng, out["x"][g], A, B, C, int(k), slip_n[g])
     return out
 
 
-def _orbit_range(eng: _Engine, x, A, B, C, k: int, slip) -> np.ndarray:
+def _orbit_range(eng: _Engine, x, A, B, C, k: int, slip) -> tuple[np.ndarray, np.ndarray]:
     """Range (rad) of p over k periods from the orbit points x (N, 2), sampled at every
     step, the extremes refined by cubic Hermite interpolation. A periodic orbit's samples
     wrap around (p(kT) = p(0)); a slipping orbit's window [0, kT] includes its start, where
-    its extreme often lies (p runs on by 2 pi n)."""
+    its extreme often lies (p runs on by 2 pi n).
+
+    And, on the eight, the distance (rad, max-norm of (p, dp/ds), p modulo 2 pi) from the
+    orbit to its mirror image: (37) is unchanged by p(t) -> -p(t + T/2) (the eight
+    reflected in its x axis half a period later), so with every orbit its mirror image is
+    an orbit too, with the same multipliers; at distance 0 the orbit is its own image,
+    otherwise the two are distinct coexisting attractors (NaN on the circle)."""
     p, dp = eng.record(x[:, 0], x[:, 1], A, B, C, k)
-    out = np.empty(x.shape[0])
+    N, n = x.shape[0], eng.n
+    mirror = np.full(N, np.nan)
+    if eng.kind == "eight" and n % 2 == 0:
+        p0, dp0 = x[:, 0] - eng.H0, x[:, 1] - eng.H1_0
+        half = np.arange(k) * n + n // 2 - 1              # samples at t = j T + T / 2
+        d = np.maximum(np.abs(_wrap(p0[:, None] + p[:, half])), np.abs(dp0[:, None] + dp[:, half]))
+        mirror = d.min(axis=1)
+    out = np.empty(N)
     cyc = np.asarray(slip) == 0
     if cyc.any():
         out[cyc] = sampled_range(p[cyc], cyclic=True, dy=dp[cyc], h=eng.h)
@@ -655,7 +670,7 @@ def _orbit_range(eng: _Engine, x, A, B, C, k: int, slip) -> np.ndarray:
         p0, dp0 = x[~cyc, 0] - eng.H0, x[~cyc, 1] - eng.H1_0
         out[~cyc] = sampled_range(np.column_stack([p0, p[~cyc]]), cyclic=False,
                                   dy=np.column_stack([dp0, dp[~cyc]]), h=eng.h)
-    return out
+    return out, mirror
 
 
 def _flow_with(eng: _Engine, s: dict, c: int, J):
@@ -784,6 +799,8 @@ class MapSummary:
     chaotic points: ``lyapunov_min``, ``lyapunov_max`` (1/s) and ``lyapunov_sigmas_min``,
     the smallest exponent in standard errors. Over the orbits: ``floquet_max``, the
     slowest contraction, and ``n_slow`` orbits with a multiplier above 0.9 in modulus.
+    ``n_asymmetric``: orbits that are not their own mirror image (mirror distance above
+    1e-6 rad), so that their mirror image coexists as a second attractor.
     ``periods_median``, ``periods_max``: reference periods integrated per point."""
 
     n_grid: int
@@ -808,6 +825,7 @@ class MapSummary:
     lyapunov_sigmas_min: float
     floquet_max: float
     n_slow: int
+    n_asymmetric: int
     periods_median: float
     periods_max: int
 
@@ -843,4 +861,5 @@ def map_summary(frame: pd.DataFrame) -> MapSummary:
         lyapunov_min=lo(cha.lyapunov), lyapunov_max=hi(cha.lyapunov),
         lyapunov_sigmas_min=lo(cha.lyapunov / cha.lyapunov_stderr),
         floquet_max=hi(orb.floquet), n_slow=int((orb.floquet > 0.9).sum()),
+        n_asymmetric=int((orb.mirror > 1e-6).sum()) if "mirror" in orb else 0,
         periods_median=float(frame.periods.median()), periods_max=int(frame.periods.max()))

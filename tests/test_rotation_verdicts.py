@@ -138,7 +138,7 @@ def test_sweep_columns_and_the_lost_definition(perturb):
     Th = np.array([math.pi / 4, 0.8, 1.0, 0.8, 0.372222])
     df = verdicts.eight_rotation_sweep(BODY, R, Th, p0=perturb(np.zeros(5)))
     for col in ("R", "Theta", "regime", "period", "range", "floquet", "lyapunov", "lyapunov_stderr", "slip",
-                "lost", "steps", "residual", "periods", "reason"):
+                "lost", "steps", "residual", "periods", "reason", "mirror"):
         assert col in df
     np.testing.assert_array_equal(df.R, R)
     assert list(df.regime) == ["periodic", "chaotic", "slipping", "periodic", "periodic"]
@@ -285,3 +285,18 @@ def test_chaos_and_contraction_are_those_of_the_full_closed_loop(point, regime):
         assert sep[-40:].max() > 1e-2
     else:
         assert sep[-1] < 1e-9
+
+
+def test_mirror_distance_separates_symmetric_orbits_from_mirror_pairs():
+    # (37) is unchanged by p(t) -> -p(t + T/2): the paper's eight has an asymmetric orbit
+    # (its mirror image is the second attractor of Chapter 3), a slow wide eight a symmetric one
+    df = verdicts.eight_rotation_sweep(BODY, [EIGHT[0], 2.0], [EIGHT[1], 0.1])
+    assert list(df.regime) == ["periodic", "periodic"]
+    assert df.mirror[0] > 0.1 and df.mirror[1] < 1e-9
+    a = verdicts.rotation_attractor(BODY, "eight", *EIGHT, p0=0.0)
+    b = verdicts.rotation_attractor(BODY, "eight", *EIGHT, p0=1.0)
+    # the mirror distance at s = 0 is the distance from one orbit's point to the other's
+    assert abs(a.states[0, 0] - b.states[0, 0]) <= df.mirror[0] + 1e-9
+    assert verdicts.map_summary(df).n_asymmetric == 1
+    circle = verdicts.rotation_verdicts(BODY, "circle", [2.0], [math.pi / 4])
+    assert circle.regime[0] == "periodic" and np.isnan(circle.mirror[0])
