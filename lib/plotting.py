@@ -10,6 +10,7 @@ from matplotlib.patches import FancyArrowPatch, Patch, Polygon
 
 import pandas as pd
 
+from .angles import wrap_angle
 from .circle_rotation import circle_critical_radius
 from .params import Body
 
@@ -231,7 +232,7 @@ def plot_heading_orbits(orbits: dict, t, p, distances: dict, multiplier: float):
     T = float(next(iter(orbits.values())).t[-1])
     last = t >= t[-1] - T - 1e-9
     tl, pl = np.mod(t[last], T), p[last]
-    near = min(orbits.values(), key=lambda o: np.abs(np.angle(np.exp(1j * (pl - np.interp(tl, o.t, o.p))))).max())
+    near = min(orbits.values(), key=lambda o: np.abs(wrap_angle(pl - np.interp(tl, o.t, o.p))).max())
     pl = pl - 2 * np.pi * np.round(np.mean(pl - np.interp(tl, near.t, near.p)) / (2 * np.pi))
     a.plot(tl, pl, "k.", ms=2, label="run from the Table's start, last period")
     a.set(xlabel="time within the period (s)", ylabel="$p$ (rad)", title="(a)")

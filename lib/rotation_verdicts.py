@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import CubicSpline
 
+from .angles import wrap_angle
 from .dynamics.orbits import floquet_multipliers
 from .integrators import batch
 from .params import Body
@@ -75,14 +76,13 @@ class _Engine:
         self.w2pi = 2 * np.pi * self.winding
         self.H0, self.H1_0 = _shape(kind)[0](0.0)[4:6]
 
-    def flow(self, phi, w, A, B, C, periods, *, jac=False, renorm=False, track=False):
-        H = self.H if track else None
+    def flow(self, phi, w, A, B, C, periods, *, jac=False, renorm=False):
         if self.engine == "numba":
             from .integrators.compiled import rotation_flow  # numba's import and compile cost seconds
 
             return rotation_flow(phi, w, A, B, C, periods, self.X1, self.Y1, self.X2, self.Y2, self.hA, self.hB,
-                                 jac=jac, renorm=renorm, H=H, wind2pi=self.w2pi)
-        return _flow_numpy(self, phi, w, A, B, C, periods, jac=jac, renorm=renorm, H=H)
+                                 jac=jac, renorm=renorm, wind2pi=self.w2pi)
+        return _flow_numpy(self, phi, w, A, B, C, periods, jac=jac, renorm=renorm)
 
     def record(self, phi, w, A, B, C, k: int):
         """p (rad) and dp/ds at every step end over k periods from (phi, w) (N, k n)."""
@@ -136,11 +136,6 @@ def _flow_numpy(eng: _Engine, phi, w, A, B, C, periods, *, jac=False, renorm=Fal
     J = Y[2:].reshape(2, 2, N).transpose(2, 0, 1).copy() if jac else np.tile(np.eye(2), (N, 1, 1))
     return dict(phi=Y[0].copy(), w=Y[1].copy(), J=J, sec=sec, logs=logs,
                 pmin=lo if H is not None else None, pmax=hi if H is not None else None)
-
-
-def _wrap(a):
-    """Angle a (rad) wrapped to [-pi, pi)."""
-    return (np.asarray(a) + np.pi) % (2 * np.pi) - np.pi
 
 
 def _candidates(hist, max_period: int, cand_tol: float):
@@ -213,7 +208,7 @@ def _orbit_points(eng: _Engine, A, B, C, x, k):
 def _distance(state, pts):
     """Distance (max-norm, phi modulo 2 pi) from states (N, 2) to the nearest of the orbit points
     (K, N, 2), and the index of that point."""
-    d = np.maximum(np.abs(_wrap(state[None, :, 0] - pts[:, :, 0])), np.abs(state[None, :, 1] - pts[:, :, 1]))
+    d = np.maximum(np.abs(wrap_angle(state[None, :, 0] - pts[:, :, 0])), np.abs(state[None, :, 1] - pts[:, :, 1]))
     d = np.where(np.isnan(d), np.inf, d)
     j = d.argmin(axis=0)
     return d[j, np.arange(d.shape[1])], j
@@ -280,7 +275,7 @@ def _try_orbits(eng, A, B, C, hist, opts, tried=None):
         out["x"][g], out["mult"][g], out["residual"][g] = x[att][reached], mult[att][reached], res[att][reached]
         out["distance"][g] = d_now[reached]
         near = pts[j_now, np.arange(a.size)][reached]
-        out["orbit_p"][g] = _wrap(near[:, 0] - eng.H0)
+        out["orbit_p"][g] = wrap_angle(near[:, 0] - eng.H0)
     return out
 
 
@@ -301,17 +296,24 @@ def section_returns(sec: np.ndarray, leave: float = 0.25) -> np.ndarray:
     L, N, _ = sec.shape
     if L < 6:
         return np.full(N, np.inf)
-    phi = _wrap(sec[:, :, 0] - sec[:1, :, 0])
+    phi = wrap_angle(sec[:, :, 0] - sec[:1, :, 0])
     w = sec[:, :, 1]
     D = np.maximum(np.ptp(phi, axis=0), np.ptp(w, axis=0))
     worst = np.zeros(N)
     for r in (0, L // 3):
-        d = np.maximum(np.abs(_wrap(phi[r + 1:] - phi[r])), np.abs(w[r + 1:] - w[r]))    # (L - r - 1, N)
+        d = np.maximum(np.abs(wrap_angle(phi[r + 1:] - phi[r])), np.abs(w[r + 1:] - w[r]))    # (L - r - 1, N)
         left = np.maximum.accumulate(d > leave * D, axis=0)          # has moved away by then
         back = np.where(left, d, np.inf).min(axis=0)
         with np.errstate(invalid="ignore", divide="ignore"):
             worst = np.maximum(worst, np.where(D > 0, back / D, np.inf))
     return worst
+
+
+def _check_body_kind(body, kind):
+    if kind not in ("eight", "circle"):
+        raise ValueError(f"kind must be 'eight' or 'circle', got {kind!r}")
+    if not isinstance(body, Body):
+        raise TypeError(f"body must be a lib.params.Body, got {type(body).__name__}")
 
 
 def _check_int(name, v, lo):
@@ -421,10 +423,7 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
     its mirror image, a second attractor), periods (integrated), steps (per period of the fine map), verdict_steps (of the verdict map),
     reason (why undecided).
     """
-    if kind not in ("eight", "circle"):
-        raise ValueError(f"kind must be 'eight' or 'circle', got {kind!r}")
-    if not isinstance(body, Body):
-        raise TypeError(f"body must be a lib.params.Body, got {type(body).__name__}")
+    _check_body_kind(body, kind)
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {sorted(ENGINES)}, got {engine!r}")
     R, Theta = _check_grid(R, Theta)
@@ -660,7 +659,7 @@ def _orbit_range(eng: _Engine, x, A, B, C, k: int, slip) -> tuple[np.ndarray, np
     if eng.kind == "eight" and n % 2 == 0:
         p0, dp0 = x[:, 0] - eng.H0, x[:, 1] - eng.H1_0
         half = np.arange(k) * n + n // 2 - 1              # samples at t = j T + T / 2
-        d = np.maximum(np.abs(_wrap(p0[:, None] + p[:, half])), np.abs(dp0[:, None] + dp[:, half]))
+        d = np.maximum(np.abs(wrap_angle(p0[:, None] + p[:, half])), np.abs(dp0[:, None] + dp[:, half]))
         mirror = d.min(axis=1)
     out = np.empty(N)
     cyc = np.asarray(slip) == 0
@@ -724,7 +723,7 @@ class RotationAttractor:
         # the orbit's p continues by the slip n: p(t + k T) = p(t) + 2 pi n
         turns = np.floor(t / kT)
         orbit = CubicSpline(self.t, self.p)(t - turns * kT) + 2 * np.pi * self.slip * turns
-        d = np.abs(_wrap(p - orbit))
+        d = np.abs(wrap_angle(p - orbit))
         j = np.floor(t / T + 1e-9).astype(int)
         n = int(np.floor(t[-1] / T + 1e-9))
         if n < 1:
@@ -747,10 +746,7 @@ def rotation_attractor(body: Body, kind: str, R: float, Theta: float, *, p0: flo
     R_, Th = _check_grid([R], [Theta])
     if not (np.isfinite(p0) and np.isfinite(v0)):
         raise ValueError("initial p0 and v0 must be finite")
-    if kind not in ("eight", "circle"):
-        raise ValueError(f"kind must be 'eight' or 'circle', got {kind!r}")
-    if not isinstance(body, Body):
-        raise TypeError(f"body must be a lib.params.Body, got {type(body).__name__}")
+    _check_body_kind(body, kind)
     h_lambda = _check_pos("h_lambda", h_lambda)
     opts = _verdict_options(options)
     n_pts, n_fine = _step_counts(body, kind, R_, Th, h_lambda, steps, opts)
@@ -768,15 +764,15 @@ def rotation_attractor(body: Body, kind: str, R: float, Theta: float, *, p0: flo
     pts = _orbit_points(eng, A, B, C, x, np.array([k]))[:k, 0]          # P(x), ..., P^k(x) ~ x + shift
     pts = np.concatenate([x, pts[:-1]])
     # start at the orbit point nearest to the run's end (the one reported by orbit_p)
-    j = int(np.argmin(np.abs(_wrap(pts[:, 0] - eng.H0 - res["orbit_p"][0]))))
+    j = int(np.argmin(np.abs(wrap_angle(pts[:, 0] - eng.H0 - res["orbit_p"][0]))))
     x0 = pts[j:j + 1].copy()
-    x0[0, 0] = eng.H0 + _wrap(x0[0, 0] - eng.H0)
+    x0[0, 0] = eng.H0 + wrap_angle(x0[0, 0] - eng.H0)
     p, dp = eng.record(x0[:, 0], x0[:, 1], A, B, C, k)
     p = np.concatenate([[x0[0, 0] - eng.H0], p[0]])
     t = np.arange(p.size) * eng.h / Th[0]
     states = np.roll(pts, -j, axis=0)
     H1_0 = _shape(kind)[0](0.0)[5]
-    states = np.column_stack([_wrap(states[:, 0] - eng.H0), (states[:, 1] - H1_0) * Th[0]])
+    states = np.column_stack([wrap_angle(states[:, 0] - eng.H0), (states[:, 1] - H1_0) * Th[0]])
     return RotationAttractor(regime=regime, period=k, slip=int(round(res["slip"][0] * k)), states=states,
                              multipliers=res["mult"][0], t=t, p=p, range=float(res["range"][0]),
                              residual=float(res["residual"][0]), periods=int(res["periods"][0]))
