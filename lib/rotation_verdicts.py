@@ -13,6 +13,7 @@ Units: R in m, Theta in rad/s, angles in rad, the phase s in rad; w = d phi / ds
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import MappingProxyType
 
 import numpy as np
 import pandas as pd
@@ -25,7 +26,7 @@ from .params import Body
 from .rotation import ENGINES, _check_grid, _forcing, _initial, _shape, _unit_forcing, sampled_range
 from .rotation_field import coefficients, rotation_rates, rotation_rates_dphi
 
-__all__ = ["REGIMES", "verdict_steps", "section_returns", "rotation_verdicts", "eight_rotation_sweep", "RotationAttractor",
+__all__ = ["REGIMES", "VERDICT_DEFAULTS", "SLOW_FLOQUET", "verdict_steps", "section_returns", "rotation_verdicts", "eight_rotation_sweep", "RotationAttractor",
            "rotation_attractor", "MapSummary", "map_summary"]
 
 
@@ -335,6 +336,13 @@ def _check_pos(name, v):
 _DEFAULTS = dict(transient=48, min_transient=8, chunk=8, max_period=8, lyapunov_periods=300, block=12,
                  min_lyapunov_periods=72, newton_tol=1e-10, candidate_tol=0.05, reach_tol=0.05, reach_floor=1e-9,
                  lyapunov_band=0.01, slip_band=1e-3, h_verdict=0.25, return_tol=0.05)
+
+
+#: the default options of :func:`rotation_verdicts` (read-only), for the book to quote
+VERDICT_DEFAULTS = MappingProxyType(_DEFAULTS)
+
+#: a Floquet modulus above this counts as a slowly attracting orbit in :class:`MapSummary`
+SLOW_FLOQUET = 0.9
 
 
 def _verdict_options(options: dict) -> dict:
@@ -856,6 +864,6 @@ def map_summary(frame: pd.DataFrame) -> MapSummary:
         theta_min_lost=lo(frame.Theta[frame.lost]), theta_min_chaotic=lo(cha.Theta),
         lyapunov_min=lo(cha.lyapunov), lyapunov_max=hi(cha.lyapunov),
         lyapunov_sigmas_min=lo(cha.lyapunov / cha.lyapunov_stderr),
-        floquet_max=hi(orb.floquet), n_slow=int((orb.floquet > 0.9).sum()),
+        floquet_max=hi(orb.floquet), n_slow=int((orb.floquet > SLOW_FLOQUET).sum()),
         n_asymmetric=int((orb.mirror > 1e-6).sum()) if "mirror" in orb else 0,
         periods_median=float(frame.periods.median()), periods_max=int(frame.periods.max()))
