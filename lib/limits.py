@@ -155,3 +155,249 @@ def _regime_one(args) -> Regime:
     return Regime(angle_limit=bmax, section=sec, period=period, converging=converging, lyapunov=lyap.value,
                   lyapunov_stderr=lyap.stderr, verdict=verdict, n_crossings=seg.n_crossings,
                   t_sliding=seg.t_sliding)
+
+
+# ---------------------------------------------------------------- the compiled runs and their verdicts
+
+
+@dataclass(frozen=True)
+class SwitchedRuns:
+    """N runs of the switched closed loop by the compiled integrator
+    (:func:`switched_runs`): ``states`` (N, n + 1, 6) at the period ends t = k T
+    (``t`` (n + 1,), s), the error states there (``errors``, see :func:`error_state`),
+    the final modes, ``log_growth`` (N, n_lyap) the companion's log(d / d0) over each
+    period from ``lyapunov_from`` on, and the crossings of S, slides and time sliding (s)
+    of each run."""
+
+    angle_limit: np.ndarray
+    force_limit: np.ndarray
+    period: float
+    t: np.ndarray
+    states: np.ndarray
+    errors: np.ndarray
+    mode_end: np.ndarray
+    log_growth: np.ndarray
+    lyapunov_from: int
+    crossings: np.ndarray
+    slides: np.ndarray
+    t_sliding: np.ndarray
+
+
+#: steps of the compiled integrator per reference period (8th-order Dormand-Prince)
+STEPS_PER_PERIOD = 200
+
+
+def _limits_arrays(angle_limits, force_limits):
+    b = np.atleast_1d(np.asarray(angle_limits, dtype=float))
+    f = np.atleast_1d(np.asarray(np.inf if force_limits is None else force_limits, dtype=float))
+    if b.ndim != 1 or f.ndim != 1 or b.size == 0:
+        raise ValueError("angle_limits and force_limits must be scalars or 1-D arrays, not empty")
+    try:
+        b, f = np.broadcast_arrays(b, f)
+    except ValueError:
+        raise ValueError(f"angle_limits ({b.size}) and force_limits ({f.size}) must have equal lengths "
+                         "(or length 1)") from None
+    if not np.all((b > 0) & (b < np.pi)):
+        raise ValueError(f"every angle limit must be in (0, pi) rad, got {b[~((b > 0) & (b < np.pi))][:3]}")
+    if np.any(np.isnan(f)) or not np.all(f > 0):
+        raise ValueError("every force limit must be positive (N) or inf for none")
+    return b.copy(), f.copy()
+
+
+def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_limits=None, *, s0=None,
+                  n_periods: int, lyapunov_from: int | None = None, steps_per_period: int = STEPS_PER_PERIOD,
+                  d0: float = 1e-7, k_slide: float = 5.0) -> SwitchedRuns:
+    """Run the closed loop (2)-(4), (23), (25)-(26) with |beta| <= ``angle_limits`` (rad)
+    and F <= ``force_limits`` (N; None or inf for no cap), one run per pair, for
+    ``n_periods`` reference periods from the states ``s0`` ((6,) or (N, 6); default the
+    paper's initial state) at t = 0, by the compiled event-located integrator
+    (:mod:`lib.integrators.switched_compiled`). With ``lyapunov_from`` = k a companion
+    run starts d0 (m, rad, m/s, rad/s: the plain Euclidean distance of states) away at the
+    end of period k and is renormalised every period (Benettin).
+
+    ``ref`` must be the circle or the eight (:mod:`lib.trajectories`). Raises
+    ``RuntimeError`` naming the run if its state becomes non-finite or the switching
+    events accumulate (more than 200 in one step)."""
+    from .integrators import switched_compiled as sc  # numba compiles on first use: only when asked
+    from .integrators.batch import dop853
+    from .trajectories import Circle, Eight
+
+    if not isinstance(body, Body) or not isinstance(gains, Gains):
+        raise TypeError("body and gains must be lib.params.Body and lib.params.Gains")
+    if not isinstance(ref, (Circle, Eight)):
+        raise TypeError(f"ref must be lib.trajectories.Circle or Eight, got {type(ref).__name__}")
+    b, f = _limits_arrays(angle_limits, force_limits)
+    if isinstance(n_periods, bool) or not isinstance(n_periods, (int, np.integer)) or n_periods < 1:
+        raise ValueError(f"n_periods must be a positive integer, got {n_periods!r}")
+    lf = -1 if lyapunov_from is None else int(lyapunov_from)
+    if lyapunov_from is not None and not 0 <= lf < n_periods - 1:
+        raise ValueError(f"lyapunov_from must be in [0, n_periods - 1), got {lyapunov_from!r}")
+    if not (isinstance(steps_per_period, (int, np.integer)) and steps_per_period >= 16):
+        raise ValueError(f"steps_per_period must be an integer >= 16, got {steps_per_period!r}")
+    if not (np.isfinite(d0) and 0 < d0 < 1e-3):
+        raise ValueError(f"d0 must be in (0, 1e-3), got {d0!r}")
+    S0 = np.concatenate([PAPER_Z0, PAPER_DZ0]) if s0 is None else np.asarray(s0, dtype=float)
+    S0 = np.broadcast_to(S0, (b.size, 6)) if S0.shape == (6,) or S0.shape == (1, 6) else S0
+    if S0.shape != (b.size, 6) or not np.all(np.isfinite(S0)):
+        raise ValueError(f"s0 must be a finite state (6,) or one per run ({b.size}, 6), got shape {S0.shape}")
+    if S0.shape[0] != b.size:
+        b, f = np.broadcast_to(b, S0.shape[0]).copy(), np.broadcast_to(f, S0.shape[0]).copy()
+    g = gains
+    P = np.array([body.m, body.I, body.a, body.c, body.c_phi, g.kp[0], g.kp[1], g.kv[0], g.kv[1], ref.R, ref.theta,
+                  k_slide, 0.0 if isinstance(ref, Circle) else 1.0])
+    tab = dop853()
+    T = ref.period
+    states, modes, logs, stats = sc.run_periods(P, b, f, S0, int(n_periods), int(steps_per_period), T, 0.0, lf,
+                                                float(d0), tab.A, tab.b / tab.b_den, tab.c)
+    bad = np.flatnonzero(stats[:, 4] != 0)
+    if bad.size:
+        q = int(bad[0])
+        why = "events accumulated (more than 200 in one step)" if stats[q, 4] == 1 else "the state became non-finite"
+        raise RuntimeError(f"switched run {q} (angle limit {np.degrees(b[q]):.6g} deg, force limit {f[q]:g} N): "
+                           f"{why}")
+    t = np.arange(n_periods + 1) * T
+    err = error_state(ref, np.tile(t, b.size), states.reshape(-1, 6)).reshape(states.shape)
+    return SwitchedRuns(angle_limit=b, force_limit=f, period=T, t=t, states=states, errors=err, mode_end=modes,
+                        log_growth=logs, lyapunov_from=lf, crossings=stats[:, 0].astype(int),
+                        slides=stats[:, 1].astype(int), t_sliding=stats[:, 2])
+
+
+#: regimes of :func:`limit_verdicts`, as Chapter 5 names them (:data:`lib.rotation_verdicts.REGIMES`)
+LIMIT_DEFAULTS = dict(transient=60, periods=120, block=12, max_period=8, candidate_tol=1e-3, newton_tol=1e-9,
+                      fd_step=1e-6, reach_tol=1e-3, lyapunov_band=0.01, return_tol=0.05)
+
+
+def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force_limits=None, *, s0=None,
+                   steps_per_period: int = STEPS_PER_PERIOD, **options):
+    """Decide the long-run regime of the switched closed loop for each (angle limit (rad),
+    force limit (N)) pair, with the criteria of Chapter 5 (:func:`lib.rotation_verdicts.rotation_verdicts`)
+    on the full state. Options (:data:`LIMIT_DEFAULTS`): ``transient`` periods dropped,
+    then ``periods`` periods of section and of Lyapunov renormalisation.
+
+    - **periodic** (or **slipping** if the heading advances by whole turns every k
+      periods): the section repeats at a lag k <= ``max_period`` to ``candidate_tol``;
+      Newton on P^k(x) = x + (0, 0, 2 pi n, 0, 0, 0), with the Jacobian by forward
+      differences (step ``fd_step``), converges to ``newton_tol``; the orbit attracts
+      (all Floquet multipliers, the eigenvalues of DP^k, inside the unit circle) and
+      the run's last section state is within ``reach_tol`` of it.
+    - **chaotic**: no such orbit and lambda T > max(3 SE T, ``lyapunov_band``), the
+      largest Lyapunov exponent lambda (1/s) with its standard error SE from the means
+      of blocks of ``block`` periods.
+    - **quasiperiodic**: no orbit, |lambda T| and 3 SE T below the band, and the section
+      closes on itself (:func:`lib.rotation_verdicts.section_returns` below ``return_tol``).
+    - **undecided** otherwise, with the reason.
+
+    Columns: angle_limit (rad), angle_deg, force_limit (N, inf for none), regime, period,
+    turns (of the heading per period of a slipping orbit), floquet (largest |multiplier|),
+    lyapunov and lyapunov_stderr (1/s), returns, p_range (rad) and pos_err (m, largest
+    position error) over the section, crossings, slides, t_sliding (s), reason, and orbit
+    (the located orbit's state at t = 0, [x, y, phi, xdot, ydot, phidot], or None).
+
+    Returns (a DataFrame with one row per pair, the :class:`SwitchedRuns`)."""
+    import pandas as pd
+
+    from .rotation_verdicts import section_returns
+
+    unknown = set(options) - set(LIMIT_DEFAULTS)
+    if unknown:
+        raise TypeError(f"unknown options {sorted(unknown)}; known: {sorted(LIMIT_DEFAULTS)}")
+    o = {**LIMIT_DEFAULTS, **options}
+    ntr, npr, blk, kmax = o["transient"], o["periods"], o["block"], o["max_period"]
+    if npr < 2 * blk or npr < 2 * kmax + 2:
+        raise ValueError(f"periods ({npr}) must cover two blocks ({blk}) and twice max_period ({kmax})")
+    runs = switched_runs(body, gains, ref, angle_limits, force_limits, s0=s0, n_periods=ntr + npr,
+                         lyapunov_from=ntr, steps_per_period=steps_per_period)
+    T, N = runs.period, runs.states.shape[0]
+    # the Lyapunov exponent and its batch-means standard error
+    nb = npr // blk
+    means = runs.log_growth[:, -nb * blk:].reshape(N, nb, blk).mean(axis=2) / T
+    lam = runs.log_growth.mean(axis=1) / T
+    se = means.std(axis=1, ddof=1) / np.sqrt(nb)
+    # candidates: the smallest lag at which the last section states repeat (p modulo 2 pi)
+    sec = runs.errors[:, ntr:]
+    k_cand = np.zeros(N, dtype=int)
+    for k in range(kmax, 0, -1):
+        d = sec[:, -2 * kmax:] - sec[:, -2 * kmax - k:-k]
+        d[..., 4] = wrap_angle(d[..., 4])
+        close = np.abs(d).max(axis=(1, 2)) < o["candidate_tol"]
+        k_cand[close] = k
+    orbit = _locate_orbits(body, gains, ref, runs, k_cand, o, steps_per_period)
+    returns = section_returns(np.moveaxis(sec, 0, 1), angles=(4,))
+    band = o["lyapunov_band"]
+    rows = []
+    for q in range(N):
+        k, ob = int(k_cand[q]), orbit.get(q)
+        lamT, seT = lam[q] * T, se[q] * T
+        regime, reason, period, turns, mu, x = "undecided", "", 0, 0, np.nan, None
+        if ob is not None and ob["converged"] and ob["mu"] < 1 and ob["reach"] < o["reach_tol"]:
+            period, turns, mu, x = k, ob["turns"], ob["mu"], ob["orbit"]
+            regime = "slipping" if turns else "periodic"
+        elif lamT > max(3 * seT, band):
+            regime = "chaotic"
+        elif abs(lamT) < band and 3 * seT < band and returns[q] < o["return_tol"]:
+            regime = "quasiperiodic"
+        elif ob is not None:
+            mu = ob["mu"]
+            reason = ("Newton did not converge" if not ob["converged"] else
+                      f"orbit of period {k} not attracting" if ob["mu"] >= 1 else "orbit not reached")
+        elif abs(lamT) < band and 3 * seT < band:
+            reason = "zero exponent, section does not close"
+        else:
+            reason = "exponent not resolved from zero"
+        p = sec[q, :, 4]
+        rows.append(dict(angle_limit=runs.angle_limit[q], angle_deg=float(np.degrees(runs.angle_limit[q])),
+                         force_limit=runs.force_limit[q], regime=regime, period=period, turns=turns,
+                         floquet=mu, lyapunov=lam[q], lyapunov_stderr=se[q], returns=returns[q],
+                         p_range=float(np.ptp(p)), pos_err=float(np.hypot(sec[q, :, 0], sec[q, :, 1]).max()),
+                         crossings=int(runs.crossings[q]), slides=int(runs.slides[q]),
+                         t_sliding=float(runs.t_sliding[q]), reason=reason, orbit=x))
+    return pd.DataFrame(rows), runs
+
+
+def _locate_orbits(body, gains, ref, runs: SwitchedRuns, k_cand, o, steps_per_period):
+    """Newton on P^k for every run with a candidate lag k > 0, all runs at once: the
+    Jacobian by forward differences (6 extra runs per candidate). Returns
+    {run: dict(converged, mu (largest Floquet modulus), turns, reach)}."""
+    idx = np.flatnonzero(k_cand > 0)
+    if idx.size == 0:
+        return {}
+    K = int(k_cand[idx].max())
+    x = runs.states[idx, -1].copy()
+    x[:, 2] = np.mod(x[:, 2], 2 * np.pi)     # the map commutes with whole turns of phi
+    b, f, kq = runs.angle_limit[idx], runs.force_limit[idx], k_cand[idx]
+    h = o["fd_step"]
+    E = np.eye(6)
+    n = idx.size
+    done = np.zeros(n, dtype=bool)
+    res_norm = np.full(n, np.inf)
+    J = np.zeros((n, 6, 6))
+    turns = np.zeros(n, dtype=int)
+    for _ in range(12):
+        starts = np.concatenate([x[:, None, :], x[:, None, :] + h * E[None]], axis=1).reshape(-1, 6)
+        out = switched_runs(body, gains, ref, np.repeat(b, 7), np.repeat(f, 7), s0=starts, n_periods=K,
+                            steps_per_period=steps_per_period).states
+        Pk = out[np.arange(7 * n), np.repeat(kq, 7)].reshape(n, 7, 6)
+        turns = np.rint((Pk[:, 0, 2] - x[:, 2]) / (2 * np.pi)).astype(int)
+        shift = np.zeros((n, 6))
+        shift[:, 2] = 2 * np.pi * turns
+        r = Pk[:, 0] - x - shift
+        res_norm = np.abs(r).max(axis=1)
+        J = np.moveaxis((Pk[:, 1:] - Pk[:, :1]) / h, 1, 2)             # J[:, :, j] = d P^k / d x_j
+        done = res_norm < o["newton_tol"]
+        if done.all():
+            break
+        step = np.linalg.solve(J - np.eye(6)[None], -r[..., None])[..., 0]
+        step *= np.minimum(1.0, 0.1 / np.maximum(np.abs(step).max(axis=1), 1e-300))[:, None]
+        x = np.where(done[:, None], x, x + step)
+    mu = np.abs(np.linalg.eigvals(J)).max(axis=1)
+    # reach: the run's last section state against the orbit's k states (p modulo 2 pi)
+    orb = switched_runs(body, gains, ref, b, f, s0=x, n_periods=K, steps_per_period=steps_per_period)
+    out = {}
+    for j, q in enumerate(idx):
+        last = runs.states[q, -1]
+        pts = orb.states[j, :kq[j]]
+        d = last[None] - pts
+        d[:, 2] = wrap_angle(d[:, 2])
+        out[int(q)] = dict(converged=bool(done[j]), mu=float(mu[j]), turns=int(turns[j]),
+                           reach=float(np.abs(d).max(axis=1).min()), orbit=x[j])
+    return out

@@ -280,29 +280,32 @@ def _try_orbits(eng, A, B, C, hist, opts, tried=None):
     return out
 
 
-def section_returns(sec: np.ndarray, leave: float = 0.25) -> np.ndarray:
-    """How a sequence of section states fails to come back: for states ``sec`` (L, N, 2)
-    (phi (rad, any multiple of 2 pi), w) of N runs, and reference states at 0 and L/3,
+def section_returns(sec: np.ndarray, leave: float = 0.25, angles=(0,)) -> np.ndarray:
+    """How a sequence of section states fails to come back: for states ``sec`` (L, N, d)
+    of N runs (by default (phi (rad, any multiple of 2 pi), w); the columns ``angles``
+    are compared modulo 2 pi), and reference states at 0 and L/3,
     the closest return of a later state to the reference state after the run has first
     moved more than ``leave`` times the set's diameter D away from it, divided by D
-    (max-norm, phi modulo 2 pi); the worse of the two references. Small (-> 0 as L
+    (max-norm, angles modulo 2 pi); the worse of the two references. Small (-> 0 as L
     grows) on a closed invariant curve filled by a quasi-periodic motion, which comes
     back near every point; at least ``leave`` for a motion that moves away for good
     (inf if it never moves that far), e.g. a slow
     approach to an orbit along a line, which a zero Lyapunov exponent alone would not
     tell apart. Returns (N,)."""
-    sec = np.asarray(sec, dtype=float)
-    if sec.ndim != 3 or sec.shape[2] != 2:
-        raise ValueError(f"sec must have shape (L, N, 2), got {sec.shape}")
+    sec = np.array(sec, dtype=float)
+    if sec.ndim != 3 or sec.shape[2] < 1:
+        raise ValueError(f"sec must have shape (L, N, d), got {sec.shape}")
     L, N, _ = sec.shape
     if L < 6:
         return np.full(N, np.inf)
-    phi = wrap_angle(sec[:, :, 0] - sec[:1, :, 0])
-    w = sec[:, :, 1]
-    D = np.maximum(np.ptp(phi, axis=0), np.ptp(w, axis=0))
+    ang = list(angles)
+    sec[:, :, ang] = wrap_angle(sec[:, :, ang] - sec[:1, :, ang])
+    D = np.ptp(sec, axis=0).max(axis=1)
     worst = np.zeros(N)
     for r in (0, L // 3):
-        d = np.maximum(np.abs(wrap_angle(phi[r + 1:] - phi[r])), np.abs(w[r + 1:] - w[r]))    # (L - r - 1, N)
+        dd = sec[r + 1:] - sec[r]
+        dd[:, :, ang] = wrap_angle(dd[:, :, ang])
+        d = np.abs(dd).max(axis=2)                                   # (L - r - 1, N)
         left = np.maximum.accumulate(d > leave * D, axis=0)          # has moved away by then
         back = np.where(left, d, np.inf).min(axis=0)
         with np.errstate(invalid="ignore", divide="ignore"):

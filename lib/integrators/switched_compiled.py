@@ -1,0 +1,368 @@
+"""The compiled switched integrator: the closed loop with an angle limit (and an optional
+force cap), integrated in numba with a fixed step, event location and Filippov
+sliding, for many runs at once (one run per parallel loop).
+
+It integrates the same system as :class:`lib.integrators.switched.SwitchedLoop`
+(see that module for the switching surface S = {lat = 0, lon < 0}, the one-sided
+fields continued across S, the sliding field and the kinks), with the same
+modes (+1 / -1 smooth on a side, 0 sliding), by a different scheme:
+
+- every reference period T is cut into ``steps_per_period`` equal steps of an
+  explicit Runge-Kutta method (8th-order Dormand-Prince by default), so that the
+  discrete period map is exactly T-periodic, as the flow's is;
+- at the end of each step the event functions are evaluated: the switching
+  function mode * lat + eps_lat (watched falling through zero), the sliding
+  exits r_+ + k lat (rising) and r_- + k lat (falling), and the kinks
+  |tau| sin(psi -+ beta_max) and |tau|^2 - F_max^2 (either way). If one changed
+  sign, the step is redone from its start with a shorter step, the length
+  found by the Illinois method on the event function (every third try a
+  bisection), until the first event is bracketed to ``1e-11`` s. The run then
+  lands just past the event, so that no step straddles a switching or a kink,
+  and the step's remainder follows with the new mode. No state is interpolated;
+- the mode after a crossing of S is decided as in ``SwitchedLoop``: cross if the
+  far side's field carries on through S, slide if both fields point into S.
+
+eps_lat = 1e-9 N makes the crossing unambiguous: a run lands 1e-9 N beyond S,
+and a run leaving a slide with |lat| below it cannot be caught by the surface
+it just left. The largest Lyapunov exponent is estimated as
+:func:`lib.dynamics.lyapunov.largest_lyapunov` does (Benettin: a companion run
+at distance d0, renormalised every period), inside the compiled loop.
+
+``tests/test_limits.py`` checks this integrator against ``SwitchedLoop`` at tight
+tolerance (crossings, slides and kinks) and its exponents against the slow path.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+__all__ = ["run_periods", "EPS_LAT", "N_EVENTS"]
+
+#: the switching function is watched at mode * lat + EPS_LAT (N)
+EPS_LAT = 1e-9
+#: number of event functions per mode (switching or exits, two clip kinks, the cap)
+N_EVENTS = 4
+_TWO_PI = 2.0 * math.pi
+_T_TOL = 1e-11
+_MAX_EVENTS_PER_STEP = 200
+
+# layout of the parameter vector P
+_M, _I, _A, _C, _CPHI, _KPX, _KPY, _KVX, _KVY, _R, _TH, _KSLIDE, _KIND = range(13)
+
+
+@numba.njit(cache=True)
+def _kin(P, t):
+    """Position, velocity, acceleration and jerk of the reference (circle (27) or eight (28))."""
+    R, th = P[_R], P[_TH]
+    s = th * t
+    if P[_KIND] == 0.0:
+        c, sn = math.cos(s), math.sin(s)
+        return (R * c, R * sn, -R * th * sn, R * th * c, -R * th**2 * c, -R * th**2 * sn,
+                R * th**3 * sn, -R * th**3 * c)
+    c1, s1, c2, s2 = math.cos(s), math.sin(s), math.cos(2 * s), math.sin(2 * s)
+    return (0.5 * R * s2, R * s1, R * th * c2, R * th * c1, -2 * R * th**2 * s2, -R * th**2 * s1,
+            -4 * R * th**3 * c2, -R * th**3 * c1)
+
+
+@numba.njit(cache=True)
+def _field(P, lim, mode, t, s, out, g):
+    """Rates of state s under ``mode`` into ``out`` (6,), event functions into ``g`` (4,);
+    ``lim`` = (beta_max, cos beta_max, sin beta_max, F_max)."""
+    bmax, cb, sb, fmax = lim
+    m, I, a, cc, cphi = P[_M], P[_I], P[_A], P[_C], P[_CPHI]
+    xd, yd, vxd, vyd, axd, ayd, jxd, jyd = _kin(P, t)
+    x, y, phi, vx, vy, w = s[0], s[1], s[2], s[3], s[4], s[5]
+    tx = m * axd + cc * vx + P[_KVX] * (vxd - vx) + P[_KPX] * (xd - x)
+    ty = m * ayd + cc * vy + P[_KVY] * (vyd - vy) + P[_KPY] * (yd - y)
+    c, sn = math.cos(phi), math.sin(phi)
+    lat, lon = ty * c - tx * sn, tx * c + ty * sn
+    tn = math.hypot(tx, ty)
+    F = min(tn, fmax)
+    ksl = P[_KSLIDE]
+    # the clip's edges and the cap: kinks of the smooth fields
+    g[1] = lat * cb - lon * sb
+    g[2] = lat * cb + lon * sb
+    g[3] = tx * tx + ty * ty - fmax * fmax if fmax < math.inf else 1.0
+    if mode != 0:
+        # beta = clip(psi, +-beta_max), psi = atan2(lat, lon) the demand's angle to the axis,
+        # continued by mode * 2 pi just across S; its cosine and sine without trigonometry
+        if lon < 0 and mode * lat < 0:
+            cbe, sbe = cb, mode * sb
+        elif lon >= tn * cb and tn > 0:
+            cbe, sbe = lon / tn, lat / tn
+        else:
+            cbe, sbe = cb, (sb if lat >= 0 else -sb)
+        ax = (F * (c * cbe - sn * sbe) - cc * vx) / m
+        ay = (F * (sn * cbe + c * sbe) - cc * vy) / m
+        aw = (a * F * sbe - cphi * w) / I
+        g[0] = mode * lat + EPS_LAT
+    else:
+        apx = (F * (c * cb - sn * sb) - cc * vx) / m
+        apy = (F * (sn * cb + c * sb) - cc * vy) / m
+        amx = (F * (c * cb + sn * sb) - cc * vx) / m
+        amy = (F * (sn * cb - c * sb) - cc * vy) / m
+        awp = (a * F * sb - cphi * w) / I
+        awm = (-a * F * sb - cphi * w) / I
+        rp = _lat_rate(P, s, apx, apy, tx, ty, vxd, vyd, axd, ayd, jxd, jyd, c, sn)
+        rm = _lat_rate(P, s, amx, amy, tx, ty, vxd, vyd, axd, ayd, jxd, jyd, c, sn)
+        lam = (rm + ksl * lat) / (rm - rp)
+        ax = lam * apx + (1 - lam) * amx
+        ay = lam * apy + (1 - lam) * amy
+        aw = lam * awp + (1 - lam) * awm
+        g[0] = rp + ksl * lat
+        g[1] = rm + ksl * lat
+        g[2] = 1.0  # while sliding beta is the Filippov average, not a clip: no clip kinks
+    out[0], out[1], out[2], out[3], out[4], out[5] = vx, vy, w, ax, ay, aw
+    return lat, lon
+
+
+@numba.njit(cache=True)
+def _lat_rate(P, s, ax, ay, tx, ty, vxd, vyd, axd, ayd, jxd, jyd, c, sn):
+    m, cc = P[_M], P[_C]
+    dtx = m * jxd + cc * ax + P[_KVX] * (axd - ax) + P[_KPX] * (vxd - s[3])
+    dty = m * jyd + cc * ay + P[_KVY] * (ayd - ay) + P[_KPY] * (vyd - s[4])
+    return dty * c - dtx * sn - s[5] * (tx * c + ty * sn)
+
+
+@numba.njit(cache=True)
+def _one_sided(P, lim, t, s):
+    """(lon, rate of lat under beta = +beta_max, under beta = -beta_max)."""
+    bmax, fmax = lim[0], lim[3]
+    m, cc = P[_M], P[_C]
+    xd, yd, vxd, vyd, axd, ayd, jxd, jyd = _kin(P, t)
+    tx = m * axd + cc * s[3] + P[_KVX] * (vxd - s[3]) + P[_KPX] * (xd - s[0])
+    ty = m * ayd + cc * s[4] + P[_KVY] * (vyd - s[4]) + P[_KPY] * (yd - s[1])
+    c, sn = math.cos(s[2]), math.sin(s[2])
+    F = min(math.hypot(tx, ty), fmax)
+    rp = _lat_rate(P, s, (F * math.cos(s[2] + bmax) - cc * s[3]) / m, (F * math.sin(s[2] + bmax) - cc * s[4]) / m,
+                   tx, ty, vxd, vyd, axd, ayd, jxd, jyd, c, sn)
+    rm = _lat_rate(P, s, (F * math.cos(s[2] - bmax) - cc * s[3]) / m, (F * math.sin(s[2] - bmax) - cc * s[4]) / m,
+                   tx, ty, vxd, vyd, axd, ayd, jxd, jyd, c, sn)
+    return tx * c + ty * sn, rp, rm
+
+
+@numba.njit(cache=True)
+def _step(P, lim, mode, t, s, h, A, b, c, K, ys, out, g):
+    """One explicit Runge-Kutta step of size h from (t, s) into ``out``; the event
+    functions at its end into ``g``."""
+    n_st = c.size
+    for i in range(n_st):
+        for q in range(6):
+            ys[q] = s[q]
+        for j in range(i):
+            if A[i, j] != 0.0:
+                for q in range(6):
+                    ys[q] += h * A[i, j] * K[j, q]
+        _field(P, lim, mode, t + c[i] * h, ys, K[i], g)
+    for q in range(6):
+        acc = 0.0
+        for i in range(n_st):
+            if b[i] != 0.0:
+                acc += b[i] * K[i, q]
+        out[q] = s[q] + h * acc
+    _field(P, lim, mode, t + h, out, ys, g)
+
+
+@numba.njit(cache=True)
+def _fired(mode, g0, g1, k):
+    """Whether event k fired between values g0 and g1 (its direction depends on the mode)."""
+    if mode != 0:
+        if k == 0:
+            return g0[0] > 0.0 and g1[0] <= 0.0
+    else:
+        if k == 0:
+            return g0[0] <= 0.0 and g1[0] > 0.0
+        if k == 1:
+            return g0[1] > 0.0 and g1[1] <= 0.0
+    return (g0[k] > 0.0) != (g1[k] > 0.0)
+
+
+@numba.njit(cache=True)
+def _initial_mode(P, lim, t, s, g, tmp):
+    lat, lon = _field(P, lim, 1, t, s, tmp, g)
+    return 1 if lat >= 0 else -1
+
+
+@numba.njit(cache=True)
+def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2, stats):
+    """Integrate s (in place) over n_steps steps of size h from t0; returns the final mode.
+    stats: [crossings, slides, time sliding, events, failed]."""
+    _field(P, lim, mode, t0, s, ys, g0)
+    for j in range(n_steps):
+        t = t0 + j * h
+        t_end = t0 + (j + 1) * h
+        n_ev = 0
+        while True:
+            dt = t_end - t
+            if dt <= 1e-13 * (1.0 + abs(t_end)):
+                break
+            _step(P, lim, mode, t, s, dt, A, b, c, K, ys, y1, g1)
+            first = -1
+            for k in range(N_EVENTS):
+                if _fired(mode, g0, g1, k):
+                    first = k
+                    break
+            if first < 0:
+                if mode == 0:
+                    stats[2] += dt
+                for q in range(6):
+                    s[q] = y1[q]
+                for k in range(N_EVENTS):
+                    g0[k] = g1[k]
+                t = t_end
+                break
+            # bracket the first event in (lo, hi]: Illinois on the target event, every third try a bisection
+            lo, hi = 0.0, dt
+            ev = first
+            glo, ghi = g0[ev], g1[ev]
+            for q in range(6):
+                y2[q] = y1[q]
+            for k in range(N_EVENTS):
+                g2[k] = g1[k]
+            side = 0
+            it = 0
+            while hi - lo > _T_TOL and it < 200:
+                it += 1
+                if it % 3 == 0 or ghi == glo:
+                    th = 0.5 * (lo + hi)
+                else:
+                    th = (lo * ghi - hi * glo) / (ghi - glo)
+                    if not (lo < th < hi):
+                        th = 0.5 * (lo + hi)
+                _step(P, lim, mode, t, s, th, A, b, c, K, ys, y1, g1)
+                hit = -1
+                for k in range(N_EVENTS):
+                    if _fired(mode, g0, g1, k):
+                        hit = k
+                        if k == ev:
+                            break
+                if hit >= 0:  # an event before th
+                    hi = th
+                    for q in range(6):
+                        y2[q] = y1[q]
+                    for k in range(N_EVENTS):
+                        g2[k] = g1[k]
+                    if hit != ev:  # another event comes first: follow it from here on
+                        ev = hit
+                        side = 0
+                        glo = g0[ev]
+                    ghi = g1[ev]
+                    if side == 1:
+                        glo *= 0.5
+                    side = 1
+                else:
+                    lo = th
+                    glo = g1[ev]
+                    if side == -1:
+                        ghi *= 0.5
+                    side = -1
+            if mode == 0:
+                stats[2] += hi
+            t += hi
+            for q in range(6):
+                s[q] = y2[q]
+            stats[3] += 1
+            n_ev += 1
+            if n_ev > _MAX_EVENTS_PER_STEP:
+                stats[4] = 1.0
+                return mode
+            # the event that fired at the landing point (the switching/exit events take precedence)
+            ev = -1
+            for k in range(N_EVENTS):
+                if _fired(mode, g0, g2, k):
+                    ev = k
+                    break
+            if mode != 0 and ev == 0:
+                lon, rp, rm = _one_sided(P, lim, t, s)
+                far = rm if mode == 1 else rp
+                near = rp if mode == 1 else rm
+                if lon >= 0 or mode * far < 0:
+                    mode = -mode
+                    if lon < 0:
+                        stats[0] += 1
+                elif mode * near < 0:
+                    mode = 0
+                    stats[1] += 1
+                # else: a grazing touch, both fields carry the run back: keep the mode
+            elif mode == 0 and ev == 0:
+                mode = 1
+            elif mode == 0 and ev == 1:
+                mode = -1
+            _field(P, lim, mode, t, s, ys, g0)
+        for q in range(6):
+            if not math.isfinite(s[q]):
+                stats[4] = 2.0
+                return mode
+    return mode
+
+
+@numba.njit(cache=True, parallel=True)
+def _run(P, bmax, fmax, S0, n_periods, n_steps, T, t0, lyap_from, d0, A, b, c, sections, modes, logs, stats):
+    N = S0.shape[0]
+    for q in numba.prange(N):
+        n_st = c.size
+        K = np.empty((n_st, 6))
+        ys, y1, y2 = np.empty(6), np.empty(6), np.empty(6)
+        g0, g1, g2 = np.empty(N_EVENTS), np.empty(N_EVENTS), np.empty(N_EVENTS)
+        s = S0[q].copy()
+        s2 = np.empty(6)
+        st2 = np.zeros(5)
+        h = T / n_steps
+        lim = (bmax[q], math.cos(bmax[q]), math.sin(bmax[q]), fmax[q])
+        mode = _initial_mode(P, lim, t0, s, g0, ys)
+        mode2 = 1
+        for q6 in range(6):
+            sections[q, 0, q6] = s[q6]
+        for k in range(n_periods):
+            ta = t0 + k * T
+            if k == lyap_from:
+                for q6 in range(6):
+                    s2[q6] = s[q6] + d0 / math.sqrt(6.0)
+                mode2 = _initial_mode(P, lim, ta, s2, g0, ys)
+            mode = _advance(P, lim, mode, ta, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2,
+                            stats[q])
+            if stats[q, 4] != 0.0:
+                break
+            if k >= lyap_from >= 0:
+                mode2 = _advance(P, lim, mode2, ta, s2, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1,
+                                 g2, st2)
+                if st2[4] != 0.0:
+                    stats[q, 4] = st2[4]
+                    break
+                d = 0.0
+                for q6 in range(6):
+                    d += (s2[q6] - s[q6]) ** 2
+                d = math.sqrt(d)
+                logs[q, k - lyap_from] = math.log(d / d0)
+                for q6 in range(6):
+                    s2[q6] = s[q6] + (s2[q6] - s[q6]) * d0 / d
+                mode2 = _initial_mode(P, lim, ta + T, s2, g0, ys)
+            for q6 in range(6):
+                sections[q, k + 1, q6] = s[q6]
+            modes[q] = mode
+
+
+def run_periods(P: np.ndarray, angle_limits: np.ndarray, force_limits: np.ndarray, S0: np.ndarray, n_periods: int,
+                steps_per_period: int, period: float, t0: float, lyapunov_from: int, d0: float, A: np.ndarray,
+                b: np.ndarray, c: np.ndarray):
+    """Low-level entry (see :func:`lib.limits.switched_runs` for the checked one): N runs
+    of ``n_periods`` periods from states S0 (N, 6) at t0. Returns the states at the period
+    ends (N, n_periods + 1, 6), the final modes (N,), log(d/d0) of the companion per
+    period from ``lyapunov_from`` on (N, n_periods - lyapunov_from; -1 for none) and the
+    statistics (N, 5): crossings, slides, time sliding (s), events, failure flag
+    (1: an accumulation of events, 2: a non-finite state)."""
+    N = S0.shape[0]
+    sections = np.full((N, n_periods + 1, 6), np.nan)
+    modes = np.zeros(N, dtype=np.int64)
+    n_log = n_periods - lyapunov_from if lyapunov_from >= 0 else 0
+    logs = np.full((N, max(n_log, 0)), np.nan)
+    stats = np.zeros((N, 5))
+    _run(np.ascontiguousarray(P, float), np.ascontiguousarray(angle_limits, float),
+         np.ascontiguousarray(force_limits, float), np.ascontiguousarray(S0, float), int(n_periods),
+         int(steps_per_period), float(period), float(t0), int(lyapunov_from), float(d0),
+         np.ascontiguousarray(A, float), np.ascontiguousarray(b, float), np.ascontiguousarray(c, float),
+         sections, modes, logs, stats)
+    return sections, modes, logs, stats
