@@ -1,10 +1,15 @@
 """The force and angle limits of paper Sec. 5 (Chapter 4): the long-run regime of the
-closed loop under an angle limit, decided from a stroboscopic section and the
-largest Lyapunov exponent, for one angle limit or a sweep of them.
+closed loop under an angle limit (and a force cap), decided from a stroboscopic
+section, located periodic orbits with their Floquet multipliers, and the largest
+Lyapunov exponent, for one pair of limits or many at once.
 
-The closed loop with an angle limit is integrated by the switched integrator
-(:class:`lib.integrators.switched.SwitchedLoop`); the verdict tools are generic
-(:mod:`lib.dynamics`). They are re-exported here, where Chapter 4 uses them.
+Two integrators run the switched closed loop: the adaptive, event-located
+:class:`lib.integrators.switched.SwitchedLoop` (the reference, one run at a time:
+:func:`stroboscopic_section`, :func:`section_sweep`, :func:`sweep_angle_limit`)
+and the compiled fixed-step one (:mod:`lib.integrators.switched_compiled`, many
+runs at once, about a hundred times faster: :func:`switched_runs`,
+:func:`limit_verdicts`, which Chapter 4 uses). The verdict tools are generic
+(:mod:`lib.dynamics`) and re-exported here.
 """
 
 from __future__ import annotations
@@ -13,16 +18,20 @@ from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
+import pandas as pd
 
 from .angles import state_difference, wrap_angle
 from .dynamics.lyapunov import LyapunovEstimate, largest_lyapunov
 from .dynamics.sections import distinct_points, section_margin, section_period
+from .integrators.batch import dop853
 from .integrators.switched import Segments, SwitchedLoop
 from .params import PAPER_DZ0, PAPER_Z0, Body, Gains
-from .trajectories import Reference
+from .rotation_verdicts import section_returns
+from .trajectories import Circle, Eight, Reference
 
 __all__ = [
     "error_state", "stroboscopic_section", "Regime", "classify", "section_sweep", "sweep_angle_limit",
+    "SwitchedRuns", "switched_runs", "limit_verdicts", "LIMIT_DEFAULTS", "STEPS_PER_PERIOD",
     # re-exported from where they are defined
     "SwitchedLoop", "Segments", "largest_lyapunov", "LyapunovEstimate", "distinct_points", "section_period",
     "section_margin", "state_difference",
@@ -218,9 +227,7 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
     ``ref`` must be the circle or the eight (:mod:`lib.trajectories`). Raises
     ``RuntimeError`` naming the run if its state becomes non-finite or the switching
     events accumulate (more than 200 in one step)."""
-    from .integrators import switched_compiled as sc  # numba compiles on first use: only when asked
-    from .integrators.batch import dop853
-    from .trajectories import Circle, Eight
+    from .integrators.switched_compiled import run_periods  # numba compiles on first use: only when asked
 
     if not isinstance(body, Body) or not isinstance(gains, Gains):
         raise TypeError("body and gains must be lib.params.Body and lib.params.Gains")
@@ -247,7 +254,7 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
                   k_slide, 0.0 if isinstance(ref, Circle) else 1.0])
     tab = dop853()
     T = ref.period
-    states, modes, logs, stats = sc.run_periods(P, b, f, S0, int(n_periods), int(steps_per_period), T, 0.0, lf,
+    states, modes, logs, stats = run_periods(P, b, f, S0, int(n_periods), int(steps_per_period), T, 0.0, lf,
                                                 float(d0), tab.A, tab.b / tab.b_den, tab.c)
     bad = np.flatnonzero(stats[:, 4] != 0)
     if bad.size:
@@ -294,10 +301,6 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
     (the located orbit's state at t = 0, [x, y, phi, xdot, ydot, phidot], or None).
 
     Returns (a DataFrame with one row per pair, the :class:`SwitchedRuns`)."""
-    import pandas as pd
-
-    from .rotation_verdicts import section_returns
-
     unknown = set(options) - set(LIMIT_DEFAULTS)
     if unknown:
         raise TypeError(f"unknown options {sorted(unknown)}; known: {sorted(LIMIT_DEFAULTS)}")
