@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .allocation import Allocation
+from .allocation import Allocation, Limits
 from .angles import wrap_angle
 from .closed_loop import ClosedLoop
 from .integrators import batch
@@ -78,9 +78,24 @@ def _points(R, Theta, weights):
     return R, Theta, w
 
 
+def _check_loop(body, gains, kind, allocation, limits) -> Limits:
+    if kind not in KINEMATICS:
+        raise ValueError(f"unknown trajectory {kind!r}; known: {sorted(KINEMATICS)}")
+    if not isinstance(body, Body) or not isinstance(gains, Gains):
+        raise TypeError("body must be a lib.params.Body and gains a lib.params.Gains")
+    if allocation not in ("least_squares", "limited"):
+        raise ValueError(f"allocation must be 'least_squares' (limits by projection) or 'limited' (the exact "
+                         f"optimum under the limits), got {allocation!r}")
+    limits = Limits() if limits is None else limits
+    if not isinstance(limits, Limits):
+        raise TypeError(f"limits must be a lib.allocation.Limits, got {type(limits).__name__}")
+    return limits
+
+
 def closed_loop_batch(body: Body, gains: Gains, kind: str, R, Theta, weights=(1.0, 1.0, 0.0), *,
                       t_end: float, dt: float = 0.01, record_dt: float = 0.05,
-                      z0=None, dz0=None) -> BatchResult:
+                      z0=None, dz0=None, allocation: str = "least_squares",
+                      limits: Limits | None = None) -> BatchResult:
     """Integrate the closed loop with the weighted allocation for N points at once.
 
     ``kind`` is ``"circle"`` or ``"eight"``; ``R`` (m), ``Theta`` (rad/s) and
@@ -89,17 +104,26 @@ def closed_loop_batch(body: Body, gains: Gains, kind: str, R, Theta, weights=(1.
     unless ``z0``/``dz0`` (shape (3,) or (N, 3)) are given. Classical RK4 with
     step ``dt`` (s) from 0 to ``t_end`` (s); samples every ``record_dt`` (s).
     A run that becomes non-finite raises ``FloatingPointError`` naming the point.
+
+    ``limits`` (:class:`lib.allocation.Limits`: force cap F <= F_max (N), angle limit
+    |beta| <= beta_max (rad) of the paper's Sec. 5) are met either by projection,
+    ``allocation="least_squares"`` (:func:`lib.allocation.allocate_least_squares`: the
+    unconstrained optimum capped and clipped), or exactly, ``allocation="limited"``
+    (:func:`lib.allocation.allocate_limited`: the optimum over the admissible sector).
+    With no limits the two are the same law. An angle limit makes the closed-loop field
+    discontinuous (beta jumps where the optimum moves from one edge ray to the other, or
+    where the demand passes behind the body), and the fixed-step RK4 steps across those
+    jumps without locating them: its error is then of first order in ``dt`` near each
+    switch, so keep ``dt`` small (0.005 s or less) and check it against the adaptive
+    :func:`lib.simulate.simulate`, as the tests do.
     """
-    if kind not in KINEMATICS:
-        raise ValueError(f"unknown trajectory {kind!r}; known: {sorted(KINEMATICS)}")
-    if not isinstance(body, Body) or not isinstance(gains, Gains):
-        raise TypeError("body must be a lib.params.Body and gains a lib.params.Gains")
+    limits = _check_loop(body, gains, kind, allocation, limits)
     for name, v in (("t_end", t_end), ("dt", dt), ("record_dt", record_dt)):
         if not np.isfinite(v) or v <= 0:
             raise ValueError(f"{name} must be a positive finite time (s), got {v!r}")
     R, Theta, w = _points(R, Theta, weights)
     kin = KINEMATICS[kind]
-    loop = ClosedLoop.of(body, gains, lambda t: kin(R, Theta, t), Allocation("least_squares", w))
+    loop = ClosedLoop.of(body, gains, lambda t: kin(R, Theta, t), Allocation(allocation, w), limits)
     zd0, dzd0, _ = kin(R, Theta, 0.0)
     z0 = zd0 if z0 is None else np.broadcast_to(np.asarray(z0, dtype=float), zd0.shape)
     dz0 = dzd0 if dz0 is None else np.broadcast_to(np.asarray(dz0, dtype=float), dzd0.shape)
