@@ -14,6 +14,7 @@ adaptive, tight-tolerance :func:`lib.simulate.simulate`.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import MappingProxyType
 
 import numpy as np
 import pandas as pd
@@ -24,10 +25,12 @@ from .closed_loop import ClosedLoop
 from .integrators import batch
 from .params import Body, Gains
 from .robustness import perturbed
-from .rotation_verdicts import eight_rotation_sweep
+from .dynamics.orbits import floquet_multipliers
+from .rotation_verdicts import eight_rotation_sweep, section_returns
 from .trajectories import KINEMATICS
 
-__all__ = ["BatchResult", "closed_loop_batch", "steady_metrics", "MapComparison", "compare_on_map"]
+__all__ = ["BatchResult", "closed_loop_batch", "steady_metrics", "LOOP_VERDICT_DEFAULTS", "closed_loop_verdicts",
+           "MapComparison", "compare_on_map"]
 
 
 @dataclass(frozen=True)
@@ -216,3 +219,395 @@ def compare_on_map(body: Body, gains: Gains, R, Theta, w_phi: float, *, t_end: f
     return MapComparison(lost=paper.regime.to_numpy() != "periodic",
                          held=m.heading_held.to_numpy() & m.position_held.to_numpy(),
                          pos_rms=m.pos_rms.to_numpy())
+
+
+# ---------------------------------------------------------------------------------------
+# One verdict for both laws: the full closed loop, classified as Chapter 5 classifies (32)
+
+#: the default options of :func:`closed_loop_verdicts` (read-only), for the book to quote
+LOOP_VERDICT_DEFAULTS = MappingProxyType(dict(
+    steps=128, transient=32, periods=72, block=12, max_period=8, candidate_tol=0.05, newton_tol=1e-8,
+    newton_iter=8, fd_step=1e-6, reach_tol=0.05, reach_floor=1e-9, lyapunov_band=0.01, slip_band=1e-3,
+    position_band=1e-3, return_tol=0.05, d0=1e-7))
+
+
+class _PeriodFlow:
+    """The closed loop of N points in the normalised time tau = t / T_i (T_i = 2 pi / |Theta_i|
+    the reference period), all points in lockstep: ``n`` classical RK4 steps per period, so
+    the stroboscopic section of every point falls on whole tau.
+
+    The RK4 stages fall on the 2n phases tau = m / (2n) (mod 1), so the reference (z_d, dz_d,
+    ddz_d) is tabulated there once per point (the heading advanced by its winding per period).
+    Without limits, the field of the weighted allocation is evaluated in a lean form
+    (:meth:`field`): (23), the normal equations of :func:`lib.allocation.allocate_least_squares`
+    solved in closed form, and (2)-(4) with Q = B(phi) u, without passing through (F, beta);
+    the tests check it against :meth:`lib.closed_loop.ClosedLoop.rates` at random states. With
+    limits, or with w_x w_y = 0, the loop runs through :class:`ClosedLoop` itself."""
+
+    def __init__(self, body, gains, kinds, R, Theta, w, allocation, limits, n):
+        self.body, self.gains, self.kinds, self.n = body, gains, kinds, n
+        self.R, self.Theta, self.w, self.allocation, self.limits = R, Theta, w, allocation, limits
+        self.T = 2 * np.pi / np.abs(Theta)
+        frac = np.arange(2 * n + 1) / (2 * n)
+        table = np.empty((R.size, 2 * n + 1, 9))
+        for kind in np.unique(kinds):
+            r = kinds == kind
+            z, dz, ddz = KINEMATICS[kind](R[r, None], Theta[r, None], frac[None, :] * self.T[r, None])
+            table[r] = np.concatenate([z, dz, ddz], axis=-1)
+        self.table = table[:, :-1]                                              # (N, 2n, 9)
+        self.wind = table[:, -1, 2] - table[:, 0, 2]                            # heading advance per period (rad)
+        self.lean = allocation == "least_squares" and limits.force is None and limits.angle is None \
+            and bool(np.all(w[:, 0] * w[:, 1] > 0))
+
+    def kin(self, idx):
+        """The kinematics t -> (z_d, dz_d, ddz_d) of the rows ``idx`` (t (M,) in s)."""
+        R, Th, kinds = self.R[idx], self.Theta[idx], self.kinds[idx]
+        groups = [(kinds == k, KINEMATICS[k]) for k in np.unique(kinds)]
+
+        def kinematics(t):
+            t = np.broadcast_to(t, R.shape)
+            out = [np.empty(R.shape + (3,)) for _ in range(3)]
+            for r, kin in groups:
+                for o, v in zip(out, kin(R[r], Th[r], t[r])):
+                    o[r] = v
+            return tuple(out)
+        return kinematics
+
+    def reference(self, idx, tau):
+        """s_d = (z_d, dz_d) (M, 6) of the rows ``idx`` at a section, whole tau (one, or (M,))."""
+        tau = np.broadcast_to(np.asarray(tau, dtype=float), (len(idx),))
+        turns = np.round(tau)
+        if np.any(np.abs(tau - turns) > 1e-9):
+            raise ValueError("sections fall on whole tau")
+        ref = self.table[idx, 0, :6].copy()
+        ref[:, 2] += turns * self.wind[idx]
+        return ref
+
+    def _lookup(self, idx, tau: float):
+        m = tau * 2 * self.n
+        mi = int(round(m))
+        if abs(m - mi) > 1e-6:
+            raise ValueError(f"tau = {tau!r} is not a stage phase of the {self.n}-step grid")
+        turns, mi = divmod(mi, 2 * self.n)
+        ref = self.table[idx, mi].copy()
+        ref[:, 2] += turns * self.wind[idx]
+        return ref
+
+    def field(self, idx, tau: float, y):
+        """dy/dtau of the rows ``idx`` (lean form, no limits): T (dz, ddz) at t = tau T."""
+        b, g, T = self.body, self.gains, self.T[idx][:, None]
+        ref = self._lookup(idx, tau)
+        z, dz = y[:, :3], y[:, 3:]
+        tau_d = np.array([b.m, b.m, b.I]) * ref[:, 6:] + b.drag * dz + g.kv * (ref[:, 3:6] - dz) \
+            + g.kp * (ref[:, :3] - z)                                           # (23)
+        c, s = np.cos(z[:, 2]), np.sin(z[:, 2])
+        wx, wy, wp = self.w[idx].T
+        tx, ty, tp = tau_d.T
+        G11, G12, G22 = wx * c * c + wy * s * s, (wy - wx) * c * s, wx * s * s + wy * c * c + wp * b.a ** 2
+        r1, r2 = wx * c * tx + wy * s * ty, -wx * s * tx + wy * c * ty + wp * b.a * tp
+        det = G11 * G22 - G12 * G12
+        u1, u2 = (G22 * r1 - G12 * r2) / det, (G11 * r2 - G12 * r1) / det        # weighted LS, u = (F cos b, F sin b)
+        Q = np.stack([c * u1 - s * u2, s * u1 + c * u2, b.a * u2], axis=-1)     # (22)
+        return T * np.concatenate([dz, (Q - b.drag * dz) / np.array([b.m, b.m, b.I])], axis=-1)   # (2)-(4)
+
+    def rates(self, idx):
+        if self.lean:
+            return lambda tau, y: self.field(idx, tau, y)
+        T = self.T[idx]
+        loop = ClosedLoop.of(self.body, self.gains, self.kin(idx), Allocation(self.allocation, self.w[idx]),
+                             self.limits)
+        return lambda tau, y: T[:, None] * loop.rates(tau * T, y)[0]
+
+    def periods(self, idx, y, tau0: float, k: int):
+        """Integrate the rows ``idx`` from state y (M, 6) at tau0 over k periods; returns the
+        states at the k section times (k, M, 6)."""
+        f, h = self.rates(idx), 1.0 / self.n
+        out = np.empty((k,) + y.shape)
+        with np.errstate(all="ignore"):
+            for q in range(k):
+                for _, y in batch.steps(f, y, tau0 + q, h, self.n, batch.RK4):
+                    pass
+                out[q] = y
+        return out
+
+    def error_map(self, idx, e, k):
+        """P^k in error coordinates: from e = s - s_d at a section, the error state k periods
+        later; k an integer or one per row (all rows run max(k) periods, each read at its own)."""
+        k = np.broadcast_to(np.asarray(k, dtype=int), (len(idx),))
+        Y = self.periods(idx, e + self.reference(idx, 0.0), 0.0, int(k.max()))
+        return Y[k - 1, np.arange(len(idx))] - self.reference(idx, k.astype(float))
+
+
+def _loop_options(options: dict) -> dict:
+    unknown = set(options) - set(LOOP_VERDICT_DEFAULTS)
+    if unknown:
+        raise TypeError(f"unknown option(s) {sorted(unknown)}; known: {sorted(LOOP_VERDICT_DEFAULTS)}")
+    o = dict(LOOP_VERDICT_DEFAULTS, **options)
+    for name, lo in (("steps", 16), ("transient", 1), ("periods", 24), ("block", 2), ("max_period", 1),
+                     ("newton_iter", 1)):
+        v = o[name]
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
+            raise ValueError(f"{name} must be an integer >= {lo}, got {v!r}")
+        o[name] = int(v)
+    if o["periods"] // o["block"] < 3:
+        raise ValueError(f"periods ({o['periods']}) must hold at least 3 blocks of {o['block']} periods")
+    for name in ("candidate_tol", "newton_tol", "fd_step", "reach_tol", "reach_floor", "lyapunov_band",
+                 "slip_band", "position_band", "return_tol", "d0"):
+        v = o[name]
+        if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not (np.isfinite(v) and v > 0):
+            raise ValueError(f"{name} must be a positive finite number, got {v!r}")
+        o[name] = float(v)
+    return o
+
+
+def _lag_candidates(hist, max_period, tol, turns):
+    """Lags k <= max_period at which the last two section states (L, N, 6) repeat within tol,
+    up to n whole turns of p where ``turns`` (N,) allows it: (ok, n, defect), (max_period, N)."""
+    L, N = hist.shape[:2]
+    dd, nn = np.full((max_period, N), np.inf), np.zeros((max_period, N), int)
+    for k in range(1, min(max_period, L - 2) + 1):
+        worst = np.zeros(N)
+        for end in (-1, -2):
+            d = hist[end] - hist[end - k]
+            n = np.where(turns, np.round(d[:, 2] / (2 * np.pi)), 0.0)
+            d[:, 2] -= 2 * np.pi * n
+            worst = np.maximum(worst, np.abs(d).max(axis=1))
+            if end == -1:
+                nn[k - 1] = n.astype(int)
+        dd[k - 1] = worst
+    return dd <= tol, nn, dd
+
+
+def _fd_newton(flow, idx, x, k, n, opts):
+    """Newton on P^k(e) - e - (0, 0, 2 pi n, 0, 0, 0) for the rows idx, each with its own lag
+    k (M,), the Jacobian DP^k by forward differences of step ``fd_step`` (6 companions per
+    point, all in one batch). Returns e (M, 6), DP^k (M, 6, 6) at the last iterate, residual (M,)."""
+    M, eye = x.shape[0], np.eye(6)
+    shift = np.zeros((M, 6))
+    shift[:, 2] = 2 * np.pi * n
+    x = x.copy()
+    res, J = np.full(M, np.inf), np.tile(eye, (M, 1, 1))
+    todo = np.arange(M)
+    h = opts["fd_step"]
+    for it in range(opts["newton_iter"] + 1):
+        m = todo.size
+        X = np.concatenate([x[todo]] + [x[todo] + h * eye[j] for j in range(6)])
+        Y = flow.error_map(np.tile(idx[todo], 7), X, np.tile(k[todo], 7))
+        G = Y[:m] - x[todo] - shift[todo]
+        Jt = np.stack([(Y[(j + 1) * m:(j + 2) * m] - Y[:m]) / h for j in range(6)], axis=-1)
+        r = np.abs(G).max(axis=1)
+        res[todo], J[todo] = r, Jt
+        go = np.isfinite(r) & (r > opts["newton_tol"])
+        if it == opts["newton_iter"] or not go.any():
+            break
+        with np.errstate(all="ignore"):
+            dx = np.linalg.solve(Jt[go] - eye, -G[go][..., None])[..., 0]
+        dx /= np.maximum(1.0, np.abs(dx).max(axis=1) / 1.0)[:, None]
+        t = todo[go]
+        x[t] += np.where(np.isfinite(dx), dx, 0.0)
+        todo = t
+    return x, J, res
+
+
+def closed_loop_verdicts(body: Body, gains: Gains, kind: str, R, Theta, weights=(1.0, 1.0, 0.0), *,
+                         z0=None, dz0=None, allocation: str = "least_squares", limits: Limits | None = None,
+                         **options) -> pd.DataFrame:
+    """The verdict of Chapter 5 (:data:`lib.rotation_verdicts.REGIMES`, and ``lost``) for the full
+    six-state closed loop (2)-(4), (23) with the weighted allocation (weights (w_x, w_y, w_phi) per
+    point; w_phi = 0 is exactly the paper's law (25)-(26)), on ``kind`` ("eight" (28) or "circle"
+    (27)) at the points (R_i (m), Theta_i (rad/s)), from z0, dz0 ((3,) or (N, 3); default: on the
+    reference), for any weights: one criterion for both laws.
+
+    All points run together by the batch RK4 (:mod:`lib.integrators.batch`) in the normalised
+    time tau = t / T (``steps`` per reference period T = 2 pi / |Theta|, 128), so that the
+    stroboscopic section of each point, its error state e = s - s_d (x, y, p, and rates; p =
+    phi - phi_d unwrapped) at t = j T, falls on a step.
+
+    1. ``transient`` periods (32), then ``periods`` (72) more with a companion trajectory
+       (Benettin: started ``d0`` away, renormalised every period): the largest Lyapunov
+       exponent lambda T per period, with its standard error from the means of blocks of
+       ``block`` (12) periods; the drift of p (turns per period) and of the mean position
+       error (m per period), each with its batch-means standard error; ranges and RMS values.
+    2. Periodic orbit: where the last two section states repeat within ``candidate_tol`` at a
+       lag k <= ``max_period`` (8), up to n whole turns of p, Newton on P^k(e) = e + 2 pi n e_p
+       with a forward-difference Jacobian (residual <= ``newton_tol``); the orbit attracts when
+       every Floquet multiplier (eigenvalue of DP^k) lies inside the unit circle, and is reached
+       when the last section state is within ``reach_tol`` of one of its k points and has closed
+       in over the last periods no slower than the slowest multiplier allows. Verdict
+       ``periodic`` (n = 0) or ``slipping`` (n != 0). Whole turns are allowed only where
+       w_phi = 0: there the loop does not see p beyond phi modulo 2 pi; with w_phi > 0, (23)
+       demands a torque from the unwrapped p, so a state a whole turn on is a different state.
+    3. Otherwise, as in Chapter 5: ``chaotic`` when lambda T > max(3 SE, ``lyapunov_band``);
+       ``quasiperiodic`` when |lambda T| <= band, SE <= band / 3 and the (p, dp/dt) section
+       closes on itself (:func:`lib.rotation_verdicts.section_returns` <= ``return_tol``);
+       else ``undecided`` with a reason.
+
+    ``lost`` (the heading): slipping, or no orbit and |drift of p| > 3 SE + ``slip_band``
+    (1e-3 turns per period) or a range of p above 2 pi over the observed periods.
+    ``position_lost``: no orbit and either the mean position error grows by more than 3 SE +
+    ``position_band`` (1e-3 m per period) or, over the last block, the body is farther from its
+    reference point than the radius R of the path itself (the analogue of the heading's full
+    turn); or the state became non-finite.
+
+    Returns a DataFrame, one row per point: R, Theta, w_phi, regime, period, floquet (largest
+    multiplier modulus), lyapunov, lyapunov_stderr (1/s; for an orbit ln|mu_1| / (k T)),
+    slip, slip_stderr (turns per period), lost, pos_drift, pos_drift_stderr (m per period),
+    position_lost, residual, distance, p_range (rad, over the last block), p_rms (rad, RMS of
+    p wrapped to (-pi, pi], last block), pos_rms, pos_max (m, last block), periods, reason.
+    """
+    kinds = np.atleast_1d(np.asarray(kind, dtype=object))
+    if kinds.ndim != 1 or kinds.size == 0:
+        raise ValueError(f"kind must be 'circle', 'eight' or a 1-D array of them, got {kind!r}")
+    for k in set(kinds.tolist()):
+        limits = _check_loop(body, gains, k, allocation, limits)
+    R, Theta, w = _points(R, Theta, weights)
+    try:
+        kinds = np.broadcast_to(kinds, R.shape)
+    except ValueError:
+        raise ValueError(f"kind has {kinds.size} entries for {R.size} points") from None
+    o = _loop_options(options)
+    N, n, L, Bk = R.size, o["steps"], o["periods"], o["block"]
+    nb = L // Bk
+    L = nb * Bk
+    flow = _PeriodFlow(body, gains, kinds, R, Theta, np.ascontiguousarray(w), allocation, limits, n)
+    idx = np.arange(N)
+    s0 = flow.reference(idx, 0.0)
+    for name, v, sl in (("z0", z0, slice(0, 3)), ("dz0", dz0, slice(3, 6))):
+        if v is not None:
+            try:
+                s0[:, sl] = np.broadcast_to(np.asarray(v, dtype=float), (N, 3))
+            except ValueError:
+                raise ValueError(f"{name} must have shape (3,) or ({N}, 3), got {np.shape(v)}") from None
+    if not np.all(np.isfinite(s0)):
+        raise ValueError("the initial state z0, dz0 must be finite")
+    turns = w[:, 2] == 0
+
+    # 1. transient, then the observed periods with a companion
+    y = flow.periods(idx, s0, 0.0, o["transient"])[-1]
+    tau0 = float(o["transient"])
+    u = np.ones(6) / np.sqrt(6.0)
+    Y = np.concatenate([y, y + o["d0"] * u])
+    both = np.concatenate([idx, idx])
+    hist = np.empty((L + 1, N, 6))
+    hist[0] = y - flow.reference(idx, tau0)
+    logs = np.full((N, L), np.nan)
+    acc = dict(pmin=np.full(N, np.inf), pmax=np.full(N, -np.inf), lmin=np.full(N, np.inf), lmax=np.full(N, -np.inf),
+               pos=np.zeros((N, nb)), pos2=np.zeros(N), posmax=np.zeros(N), p2=np.zeros(N), cnt=np.zeros(nb))
+    for q in range(L):
+        b = q // Bk
+        last = b == nb - 1
+
+        # record at every step end: p and the position error of the base rows
+        f, h = flow.rates(both), 1.0 / n
+        with np.errstate(all="ignore"):
+            for j, (tq, Yq) in enumerate(batch.steps(f, Y, tau0 + q, h, n, batch.RK4)):
+                zd = flow._lookup(idx, tq)
+                p = Yq[:N, 2] - zd[:, 2]
+                e = np.hypot(Yq[:N, 0] - zd[:, 0], Yq[:N, 1] - zd[:, 1])
+                acc["pmin"], acc["pmax"] = np.fmin(acc["pmin"], p), np.fmax(acc["pmax"], p)
+                acc["pos"][:, b] += e
+                acc["cnt"][b] += 1
+                if last:
+                    acc["lmin"], acc["lmax"] = np.fmin(acc["lmin"], p), np.fmax(acc["lmax"], p)
+                    acc["pos2"] += e * e
+                    acc["p2"] += wrap_angle(p) ** 2
+                    acc["posmax"] = np.fmax(acc["posmax"], e)
+            Y = Yq
+            d = Y[N:] - Y[:N]
+            dn = np.sqrt((d * d).sum(axis=1))
+            logs[:, q] = np.log(dn / o["d0"])
+            Y = np.concatenate([Y[:N], Y[:N] + d * (o["d0"] / np.where(dn > 0, dn, 1.0))[:, None]])
+        hist[q + 1] = Y[:N] - flow.reference(idx, tau0 + q + 1)
+    t_end = tau0 + L
+    finite = np.all(np.isfinite(hist[-1]), axis=1) & np.all(np.isfinite(logs), axis=1)
+
+    out = dict(regime=np.full(N, "undecided", dtype=object), period=np.zeros(N, int), floquet=np.full(N, np.nan),
+               lyapunov=np.full(N, np.nan), lyapunov_stderr=np.full(N, np.nan), slip=np.full(N, np.nan),
+               slip_stderr=np.full(N, np.nan), lost=np.zeros(N, bool), pos_drift=np.full(N, np.nan),
+               pos_drift_stderr=np.full(N, np.nan), position_lost=np.zeros(N, bool), residual=np.full(N, np.nan),
+               distance=np.full(N, np.nan), reason=np.full(N, "", dtype=object))
+
+    # 2. periodic orbits: Newton from the last section state, lag by lag
+    cand, nslip, _ = _lag_candidates(np.where(finite[None, :, None], hist, np.nan), o["max_period"],
+                                     o["candidate_tol"], turns)
+    found = np.zeros(N, bool)
+    c = np.flatnonzero(cand.any(axis=0) & finite)
+    if c.size:
+        k = cand[:, c].argmax(axis=0) + 1                   # the smallest lag that repeats
+        x, J, res = _fd_newton(flow, c, hist[-1, c], k, nslip[k - 1, c], o)
+        ok = res <= o["newton_tol"]
+        mult = np.full((c.size, 6), np.nan + 0j)
+        if ok.any():
+            mult[ok] = floquet_multipliers(J[ok])
+        att = ok & (np.abs(mult[:, 0]) < 1.0)
+        a, xa, ka = c[att], x[att], k[att]
+        K = int(ka.max()) if a.size else 0
+        if a.size:
+            pts = flow.periods(a, xa + flow.reference(a, 0.0), 0.0, K)
+            pts = pts - np.stack([flow.reference(a, float(j + 1)) for j in range(K)])   # (K, M, 6)
+            pts[np.arange(K)[:, None] >= ka[None, :]] = np.nan          # past each orbit's own k
+            kmin, nmin = ka.copy(), nslip[ka - 1, a].copy()
+            for dv in range(K - 1, 0, -1):                   # the least period: d | k, P^d(x) = x
+                dd = pts[dv - 1] - xa
+                nd = np.where(turns[a], np.round(dd[:, 2] / (2 * np.pi)), 0.0)
+                dd[:, 2] -= 2 * np.pi * nd
+                same = (ka % dv == 0) & (dv < ka) & (np.abs(dd).max(axis=1) <= 1e-6)
+                kmin[same], nmin[same] = dv, nd[same].astype(int)
+
+            def dist(state):
+                dd = state[None] - pts
+                dd[..., 2] = np.where(turns[a], wrap_angle(dd[..., 2]), dd[..., 2])
+                return np.nanmin(np.abs(dd).max(axis=2), axis=0)
+
+            m = ka * np.maximum(1, 16 // ka)
+            d_now, d_then = dist(hist[-1, a]), dist(hist[-1 - m, a])
+            rho = np.abs(mult[att, 0])
+            shrink = (d_now < d_then) & (d_now <= 3.0 * d_then * rho ** (m / ka) + o["reach_floor"])
+            reached = (d_now <= o["reach_floor"]) | ((d_now <= o["reach_tol"]) & shrink)
+            g = a[reached]
+            found[g] = True
+            kk, nn = kmin[reached], nmin[reached]
+            out["regime"][g] = np.where(nn == 0, "periodic", "slipping")
+            out["period"][g], out["slip"][g], out["slip_stderr"][g] = kk, nn / kk, 0.0
+            out["lost"][g] = nn != 0
+            out["floquet"][g] = rho[reached]
+            out["lyapunov"][g] = np.log(rho[reached]) / (ka[reached] * flow.T[g])
+            out["residual"][g], out["distance"][g] = res[att][reached], d_now[reached]
+
+    # 3. no orbit: the Lyapunov exponent and the drifts
+    bm = logs.reshape(N, nb, Bk).mean(axis=2)
+    lam, se = bm.mean(axis=1), bm.std(axis=1, ddof=1) / np.sqrt(nb)
+    pb = hist[::Bk, :, 2].T                                   # p at the block ends (N, nb + 1)
+    inc = np.diff(pb, axis=1) / (2 * np.pi * Bk)
+    drift, dse = inc.mean(axis=1), inc.std(axis=1, ddof=1) / np.sqrt(nb)
+    mb = acc["pos"] / acc["cnt"]
+    pinc = np.diff(mb, axis=1) / Bk
+    pdrift, pse = pinc.mean(axis=1), pinc.std(axis=1, ddof=1) / np.sqrt(nb - 1)
+    rng = acc["pmax"] - acc["pmin"]
+    band = o["lyapunov_band"]
+    rest = ~found & finite
+    T = flow.T
+    out["lyapunov"][rest], out["lyapunov_stderr"][rest] = lam[rest] / T[rest], se[rest] / T[rest]
+    out["slip"][rest], out["slip_stderr"][rest] = drift[rest], dse[rest]
+    out["pos_drift"], out["pos_drift_stderr"] = pdrift, pse
+    chaotic = rest & (lam > np.maximum(3 * se, band))
+    zero = rest & ~chaotic & (np.abs(lam) <= band) & (se <= band / 3)
+    closed = section_returns(np.where(finite[None, :, None], hist[:, :, [2, 5]], 0.0)) <= o["return_tol"]
+    quasi = zero & closed
+    out["regime"][chaotic], out["regime"][quasi] = "chaotic", "quasiperiodic"
+    und = rest & ~chaotic & ~quasi
+    out["reason"][und] = np.where(
+        lam[und] < -np.maximum(3 * se[und], band),
+        f"contracting, but no attracting orbit of period <= {o['max_period']} reached",
+        np.where(zero[und], "Lyapunov exponent zero, but the section does not return near itself",
+                 "Lyapunov exponent not resolved from zero"))
+    out["lost"][rest] = (np.abs(drift[rest]) > 3 * dse[rest] + o["slip_band"]) | (rng[rest] > 2 * np.pi)
+    out["position_lost"][rest] = (pdrift[rest] > 3 * pse[rest] + o["position_band"]) | (acc["posmax"][rest] > R[rest])
+    bad = ~finite
+    out["reason"][bad] = "the state became non-finite (the run diverged)"
+    out["lost"][bad] = out["position_lost"][bad] = True
+    cnt = acc["cnt"][-1]
+    return pd.DataFrame({"kind": kinds, "R": R, "Theta": Theta, "w_phi": w[:, 2], **out,
+                         "p_range": acc["lmax"] - acc["lmin"], "p_rms": np.sqrt(acc["p2"] / cnt),
+                         "pos_rms": np.sqrt(acc["pos2"] / cnt), "pos_max": acc["posmax"],
+                         "periods": int(t_end), "steps": n})
