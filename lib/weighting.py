@@ -24,13 +24,12 @@ from .angles import wrap_angle
 from .closed_loop import ClosedLoop
 from .integrators import batch
 from .params import Body, Gains
-from .robustness import perturbed
 from .dynamics.orbits import floquet_multipliers
-from .rotation_verdicts import eight_rotation_sweep, section_returns
+from .rotation_verdicts import REGIMES, section_returns
 from .trajectories import KINEMATICS
 
 __all__ = ["BatchResult", "closed_loop_batch", "steady_metrics", "LOOP_VERDICT_DEFAULTS", "closed_loop_verdicts",
-           "MapComparison", "compare_on_map"]
+           "verdict_runs", "held", "stability_boundary", "MapComparison", "compare_on_map", "limits_comparison"]
 
 
 @dataclass(frozen=True)
@@ -174,51 +173,6 @@ def steady_metrics(res: BatchResult, n_periods: float = 2.0) -> pd.DataFrame:
                         position_held=bool(drift < 1e-3), F_max=float(F[last, j].max()),
                         F_rms=float(np.sqrt(np.mean(F[last, j] ** 2)))))
     return pd.DataFrame(out)
-
-
-@dataclass(frozen=True)
-class MapComparison:
-    """The two laws on a set of (R, Theta) points of the eight, from one start.
-
-    ``lost`` (N,) bool: the paper's law reaches no attracting periodic orbit of the
-    heading (regime other than ``periodic`` in Chapter 5's verdicts,
-    :func:`lib.rotation_verdicts.eight_rotation_sweep`: the broad reading of "lost");
-    ``held`` (N,) bool: under the weighted law the heading does not slip over the
-    last period and the body stays on the path (:func:`steady_metrics`);
-    ``pos_rms`` (N,) the weighted law's steady position error (m RMS).
-    """
-
-    lost: np.ndarray
-    held: np.ndarray
-    pos_rms: np.ndarray
-
-    @property
-    def counts(self) -> dict:
-        """Points lost under the paper's law, of those held by the weighted law
-        ("rescued"), and periodic under the paper's law but not held ("broken")."""
-        return {"lost": int(self.lost.sum()), "rescued": int((self.lost & self.held).sum()),
-                "broken": int((~self.lost & ~self.held).sum())}
-
-
-def compare_on_map(body: Body, gains: Gains, R, Theta, w_phi: float, *, t_end: float, dt: float = 0.02,
-                   rel: float = 0.0) -> MapComparison:
-    """Classify the paper's law and the weighted law (weights (1, 1, ``w_phi``)) on the eight
-    at the points (R_i (m), Theta_i (rad/s)), both started on the reference; with ``rel``
-    != 0 both starts are moved by :func:`lib.robustness.perturbed` (the heading error of
-    the paper's law by ``rel`` rad and ``rel`` rad/s), to show which verdicts ride on
-    the last bits of a chaotic motion. The weighted law runs for ``t_end`` (s) with
-    RK4 step ``dt`` (s)."""
-    R, Theta, _ = _points(R, Theta, (1.0, 1.0, w_phi))
-    dp0, dv0 = perturbed(np.zeros(2), rel)
-    paper = eight_rotation_sweep(body, R, Theta, p0=dp0, v0=dv0)
-    zd0, dzd0, _ = KINEMATICS["eight"](R, Theta, 0.0)
-    s0 = perturbed(np.concatenate([zd0, dzd0], axis=1), rel)
-    res = closed_loop_batch(body, gains, "eight", R, Theta, (1.0, 1.0, w_phi), t_end=t_end, dt=dt,
-                            record_dt=0.05, z0=s0[:, :3], dz0=s0[:, 3:])
-    m = steady_metrics(res)
-    return MapComparison(lost=paper.regime.to_numpy() != "periodic",
-                         held=m.heading_held.to_numpy() & m.position_held.to_numpy(),
-                         pos_rms=m.pos_rms.to_numpy())
 
 
 # ---------------------------------------------------------------------------------------
@@ -611,3 +565,138 @@ def closed_loop_verdicts(body: Body, gains: Gains, kind: str, R, Theta, weights=
                          "p_range": acc["lmax"] - acc["lmin"], "p_rms": np.sqrt(acc["p2"] / cnt),
                          "pos_rms": np.sqrt(acc["pos2"] / cnt), "pos_max": acc["posmax"],
                          "periods": int(t_end), "steps": n})
+
+
+def verdict_runs(body: Body, gains: Gains, runs: dict, **options) -> dict:
+    """Several sets of points through ONE call of :func:`closed_loop_verdicts` (the batch
+    integrator's cost is mostly per step, not per point, so one call is much cheaper than
+    several). ``runs`` maps a name to a dict with ``kind``, ``R``, ``Theta`` and optionally
+    ``weights`` ((3,) or (N, 3)), ``z0``, ``dz0`` ((3,) or (N, 3)); ``options`` go to
+    :func:`closed_loop_verdicts`. Returns the frames by name, each indexed from 0."""
+    if not runs:
+        raise ValueError("no runs given")
+    parts, sizes = [], []
+    for name, r in runs.items():
+        unknown = set(r) - {"kind", "R", "Theta", "weights", "z0", "dz0"}
+        if unknown or not {"kind", "R", "Theta"} <= set(r):
+            raise ValueError(f"run {name!r} needs kind, R, Theta (and optionally weights, z0, dz0); "
+                             f"unknown keys {sorted(unknown)}")
+        R, Theta, w = _points(r["R"], r["Theta"], r.get("weights", (1.0, 1.0, 0.0)))
+        ref = [np.concatenate(KINEMATICS[r["kind"]](R, Theta, 0.0)[:2], axis=1)] if r["kind"] in KINEMATICS else None
+        if ref is None:
+            raise ValueError(f"unknown trajectory {r['kind']!r} in run {name!r}; known: {sorted(KINEMATICS)}")
+        s0 = ref[0]
+        for key, sl in (("z0", slice(0, 3)), ("dz0", slice(3, 6))):
+            if r.get(key) is not None:
+                s0[:, sl] = np.broadcast_to(np.asarray(r[key], dtype=float), (R.size, 3))
+        parts.append((np.full(R.size, r["kind"], dtype=object), R, Theta, w, s0))
+        sizes.append(R.size)
+    kinds, R, Theta, w, s0 = (np.concatenate([p[i] for p in parts]) for i in range(5))
+    frame = closed_loop_verdicts(body, gains, kinds, R, Theta, w, z0=s0[:, :3], dz0=s0[:, 3:], **options)
+    edges = np.cumsum([0] + sizes)
+    return {name: frame.iloc[a:b].reset_index(drop=True) for name, a, b in zip(runs, edges[:-1], edges[1:])}
+
+
+def held(frame: pd.DataFrame) -> np.ndarray:
+    """(N,) bool: the closed loop reaches an attracting periodic orbit (verdict ``periodic``) and
+    neither the heading nor the position is lost, by :func:`closed_loop_verdicts`."""
+    return ((frame.regime == "periodic") & ~frame.lost & ~frame.position_lost).to_numpy()
+
+
+def stability_boundary(w_phi, frame: pd.DataFrame) -> dict:
+    """Where, along increasing weights ``w_phi`` (N,), the verdict of ``frame`` (one row per
+    weight, :func:`closed_loop_verdicts`) first stops being :func:`held`: ``last_held`` (the
+    largest weight before the first change), ``first_lost`` (the weight at it; NaN if every
+    weight holds), ``ratio`` (their quotient, the resolution of the grid there), ``changes``
+    (how often the verdict flips along the grid: more than 1 means it is not monotone), and
+    ``verdict`` (regime, and "position lost" where it is) at ``first_lost``."""
+    w = np.asarray(w_phi, dtype=float)
+    if w.ndim != 1 or w.size != len(frame) or w.size < 2 or np.any(np.diff(w) <= 0):
+        raise ValueError("w_phi must be an increasing 1-D array with one weight per row of frame")
+    h = held(frame)
+    if not h[0]:
+        raise ValueError(f"the smallest weight {w[0]:g} is not held: no boundary to locate above it")
+    bad = np.flatnonzero(~h)
+    if bad.size == 0:
+        return dict(last_held=float(w[-1]), first_lost=np.nan, ratio=np.nan, changes=0, verdict="held")
+    i = int(bad[0])
+    r = frame.iloc[i]
+    verdict = r.regime + (", position lost" if r.position_lost else "") + (", heading lost" if r.lost else "")
+    return dict(last_held=float(w[i - 1]), first_lost=float(w[i]), ratio=float(w[i] / w[i - 1]) if w[i - 1] > 0
+                else np.inf, changes=int(np.count_nonzero(np.diff(h.astype(int)))), verdict=verdict)
+
+
+@dataclass(frozen=True)
+class MapComparison:
+    """The paper's law and the weighted law on the same (R, Theta) points of the eight, from the
+    same start, over the same horizon, classified by the same :func:`closed_loop_verdicts`:
+    ``paper`` and ``weighted`` are its frames (one row per point, in the same order)."""
+
+    paper: pd.DataFrame
+    weighted: pd.DataFrame
+
+    @property
+    def lost(self) -> np.ndarray:
+        """(N,) bool: the heading is lost under the paper's law (slips, or no orbit and it
+        drifts or turns right round), Chapter 5's reading."""
+        return self.paper.lost.to_numpy()
+
+    @property
+    def held(self) -> np.ndarray:
+        """(N,) bool: the weighted law reaches a periodic orbit with heading and position held."""
+        return held(self.weighted)
+
+    @property
+    def counts(self) -> pd.DataFrame:
+        """Points per regime, heading lost and position lost, for each law (columns)."""
+        rows = {}
+        for law, f in (("paper", self.paper), ("weighted", self.weighted)):
+            c = {r: int((f.regime == r).sum()) for r in REGIMES}
+            c.update({"heading lost": int(f.lost.sum()), "position lost": int(f.position_lost.sum()),
+                      "held": int(held(f).sum())})
+            rows[law] = c
+        return pd.DataFrame(rows)
+
+    @property
+    def cross(self) -> pd.DataFrame:
+        """Points by the paper's law (rows: heading held / lost) against the weighted law
+        (columns: held, heading lost (body on the path), position lost, and periodic-or-not)."""
+        wl = np.where(self.weighted.position_lost, "position lost",
+                      np.where(self.weighted.lost, "heading lost", "heading held"))
+        pl = np.where(self.lost, "lost", "held")
+        return pd.crosstab(pd.Series(pl, name="paper's law"), pd.Series(wl, name="weighted law"))
+
+
+def compare_on_map(body: Body, gains: Gains, R, Theta, w_phi: float, **options) -> MapComparison:
+    """Classify the paper's law (w_phi = 0, exactly (25)-(26)) and the weighted law (weights
+    (1, 1, ``w_phi``)) on the eight at the points (R_i (m), Theta_i (rad/s)), both started on
+    the reference, by one call of :func:`closed_loop_verdicts` (``options`` go there)."""
+    if isinstance(w_phi, bool) or not np.isscalar(w_phi) or not np.isfinite(w_phi) or w_phi <= 0:
+        raise ValueError(f"w_phi must be a positive finite weight, got {w_phi!r}")
+    R, Theta, _ = _points(R, Theta, (1.0, 1.0, 0.0))
+    f = verdict_runs(body, gains, {"paper": dict(kind="eight", R=R, Theta=Theta, weights=(1.0, 1.0, 0.0)),
+                                   "weighted": dict(kind="eight", R=R, Theta=Theta, weights=(1.0, 1.0, w_phi))},
+                     **options)
+    return MapComparison(f["paper"], f["weighted"])
+
+
+def limits_comparison(body: Body, gains: Gains, kind: str, R: float, Theta: float, weights, limits: dict, *,
+                      periods: int = 5, dt: float = 0.01, z0=None, dz0=None) -> pd.DataFrame:
+    """The weighted law under force and angle limits, met by projection
+    (``allocation="least_squares"``) and exactly (``"limited"``), by :func:`closed_loop_batch`:
+    for each named :class:`lib.allocation.Limits` in ``limits``, both runs over ``periods``
+    reference periods with RK4 step ``dt`` (s), and :func:`steady_metrics` over the last period.
+    Returns one row per (limits, law): the limits' name, ``law``, and the metrics' columns."""
+    if not limits:
+        raise ValueError("no limits given")
+    if isinstance(periods, bool) or not isinstance(periods, (int, np.integer)) or periods < 2:
+        raise ValueError(f"periods must be an integer >= 2, got {periods!r}")
+    T = 2 * np.pi / abs(float(Theta))
+    rows = []
+    for name, lim in limits.items():
+        for law in ("least_squares", "limited"):
+            res = closed_loop_batch(body, gains, kind, R, Theta, weights, t_end=periods * T, dt=dt, record_dt=dt,
+                                    z0=z0, dz0=dz0, allocation=law, limits=lim)
+            m = steady_metrics(res, n_periods=1.0).iloc[0].to_dict()
+            rows.append({"limits": name, "law": "projection" if law == "least_squares" else "exact", **m})
+    return pd.DataFrame(rows)

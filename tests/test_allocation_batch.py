@@ -79,18 +79,31 @@ def test_simulate_allocation_option_is_validated():
                  allocation=Allocation("least_squares", (1, 1, 1)))
 
 
-def test_map_comparison_classifies_both_laws_from_the_same_start():
-    from lib import stability
-
+def test_map_comparison_classifies_both_laws_by_one_verdict():
+    # a slow wide eight settles under both laws; a fast tight one slips under the paper's law
     R, Th = np.array([3.0, 0.25]), np.array([0.3, 1.0])
-    cmp = weighting.compare_on_map(Body(), Gains(), R, Th, 0.1, t_end=3 * 2 * np.pi / 0.3 + 20.0)
-    paper = stability.eight_rotation_sweep(Body(), R, Th)
-    np.testing.assert_array_equal(cmp.lost, paper.regime.to_numpy() != "periodic")
-    assert cmp.counts == {"lost": int(cmp.lost.sum()), "rescued": int((cmp.lost & cmp.held).sum()),
-                          "broken": int((~cmp.lost & ~cmp.held).sum())}
-    assert cmp.lost.tolist() == [False, True]   # a slow wide eight settles, a fast tight one slips
+    cmp = weighting.compare_on_map(Body(), Gains(), R, Th, 0.1)
+    assert cmp.paper.w_phi.tolist() == [0.0, 0.0] and cmp.weighted.w_phi.tolist() == [0.1, 0.1]
+    assert cmp.paper.regime.tolist() == ["periodic", "slipping"] and cmp.lost.tolist() == [False, True]
+    assert cmp.counts.loc["heading lost", "paper"] == 1 and cmp.counts["paper"].loc[list(weighting.REGIMES)].sum() == 2
+    assert cmp.cross.to_numpy().sum() == 2
+    assert cmp.held[0] and cmp.weighted.pos_rms.iloc[0] < 0.05
     with pytest.raises(ValueError, match="R"):
-        weighting.compare_on_map(Body(), Gains(), [-1.0], [0.3], 0.1, t_end=10.0)
+        weighting.compare_on_map(Body(), Gains(), [-1.0], [0.3], 0.1)
+    with pytest.raises(ValueError, match="w_phi must be a positive"):
+        weighting.compare_on_map(Body(), Gains(), [1.0], [0.3], 0.0)
+
+
+def test_stability_boundary_reads_the_first_change_of_verdict():
+    import pandas as pd
+
+    f = pd.DataFrame({"regime": ["periodic", "periodic", "chaotic", "periodic"], "lost": [False] * 4,
+                      "position_lost": [False, False, True, False]})
+    b = weighting.stability_boundary([0.0, 0.1, 0.2, 0.4], f)
+    assert (b["last_held"], b["first_lost"], b["changes"]) == (0.1, 0.2, 2)
+    assert b["verdict"] == "chaotic, position lost" and b["ratio"] == pytest.approx(2.0)
+    with pytest.raises(ValueError, match="increasing"):
+        weighting.stability_boundary([0.1, 0.0, 0.2, 0.3], f)
 
 
 @pytest.mark.parametrize("law", ["least_squares", "limited"])
