@@ -20,6 +20,7 @@ test: $(STAMP)
 	$(BIN)/python -m pytest
 
 benchmark: $(STAMP)
+	$(BIN)/python benchmarks/bench_switched.py
 	$(BIN)/python benchmarks/bench_eight_sweep.py
 
 clean:

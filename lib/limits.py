@@ -31,7 +31,7 @@ from .trajectories import Circle, Eight, Reference
 
 __all__ = [
     "error_state", "stroboscopic_section", "Regime", "classify", "section_sweep", "sweep_angle_limit",
-    "SwitchedRuns", "switched_runs", "limit_verdicts", "LIMIT_DEFAULTS", "STEPS_PER_PERIOD",
+    "SwitchedRuns", "switched_runs", "limit_verdicts", "extend_undecided", "UNDECIDED_FACTOR", "regime_edges", "LIMIT_DEFAULTS", "STEPS_PER_PERIOD",
     # re-exported from where they are defined
     "SwitchedLoop", "Segments", "largest_lyapunov", "LyapunovEstimate", "distinct_points", "section_period",
     "section_margin", "state_difference",
@@ -172,8 +172,8 @@ def _regime_one(args) -> Regime:
 @dataclass(frozen=True)
 class SwitchedRuns:
     """N runs of the switched closed loop by the compiled integrator
-    (:func:`switched_runs`): ``states`` (N, n + 1, 6) at the period ends t = k T
-    (``t`` (n + 1,), s), the error states there (``errors``, see :func:`error_state`),
+    (:func:`switched_runs`): ``states`` (N, n S + 1, 6) at the sample times t = k T / S
+    (``t`` (n S + 1,), s; S samples per period, by default one), the error states there (``errors``, see :func:`error_state`),
     the final modes, ``log_growth`` (N, n_lyap) the companion's log(d / d0) over each
     period from ``lyapunov_from`` on, and the crossings of S, slides and time sliding (s)
     of each run."""
@@ -206,8 +206,8 @@ def _limits_arrays(angle_limits, force_limits):
     except ValueError:
         raise ValueError(f"angle_limits ({b.size}) and force_limits ({f.size}) must have equal lengths "
                          "(or length 1)") from None
-    if not np.all((b > 0) & (b < np.pi)):
-        raise ValueError(f"every angle limit must be in (0, pi) rad, got {b[~((b > 0) & (b < np.pi))][:3]}")
+    if not np.all((b > 0) & (b <= np.pi)):
+        raise ValueError(f"every angle limit must be in (0, pi] rad, got {b[~((b > 0) & (b <= np.pi))][:3]}")
     if np.any(np.isnan(f)) or not np.all(f > 0):
         raise ValueError("every force limit must be positive (N) or inf for none")
     return b.copy(), f.copy()
@@ -215,14 +215,16 @@ def _limits_arrays(angle_limits, force_limits):
 
 def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_limits=None, *, s0=None,
                   n_periods: int, lyapunov_from: int | None = None, steps_per_period: int = STEPS_PER_PERIOD,
-                  d0: float = 1e-7, k_slide: float = 5.0) -> SwitchedRuns:
-    """Run the closed loop (2)-(4), (23), (25)-(26) with |beta| <= ``angle_limits`` (rad)
-    and F <= ``force_limits`` (N; None or inf for no cap), one run per pair, for
-    ``n_periods`` reference periods from the states ``s0`` ((6,) or (N, 6); default the
-    paper's initial state) at t = 0, by the compiled event-located integrator
-    (:mod:`lib.integrators.switched_compiled`). With ``lyapunov_from`` = k a companion
-    run starts d0 (m, rad, m/s, rad/s: the plain Euclidean distance of states) away at the
-    end of period k and is renormalised every period (Benettin).
+                  samples_per_period: int = 1, d0: float = 1e-7, k_slide: float = 5.0) -> SwitchedRuns:
+    """Run the closed loop (2)-(4), (23), (25)-(26) with |beta| <= ``angle_limits`` (rad;
+    pi for no angle limit) and F <= ``force_limits`` (N; None or inf for no cap), one run
+    per pair, for ``n_periods`` reference periods from the states ``s0`` ((6,) or (N, 6);
+    default the paper's initial state) at t = 0, by the compiled event-located integrator
+    (:mod:`lib.integrators.switched_compiled`), recording the state ``samples_per_period``
+    times per period (it must divide ``steps_per_period``). With ``lyapunov_from`` = k
+    (only with one sample per period) a companion run starts d0 (m, rad, m/s, rad/s: the
+    plain Euclidean distance of states) away at the end of period k and is renormalised
+    every period (Benettin).
 
     ``ref`` must be the circle or the eight (:mod:`lib.trajectories`). Raises
     ``RuntimeError`` naming the run if its state becomes non-finite or the switching
@@ -241,6 +243,12 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
         raise ValueError(f"lyapunov_from must be in [0, n_periods - 1), got {lyapunov_from!r}")
     if not (isinstance(steps_per_period, (int, np.integer)) and steps_per_period >= 16):
         raise ValueError(f"steps_per_period must be an integer >= 16, got {steps_per_period!r}")
+    S = samples_per_period
+    if not (isinstance(S, (int, np.integer)) and S >= 1 and steps_per_period % S == 0):
+        raise ValueError(f"samples_per_period must be a positive integer dividing steps_per_period "
+                         f"({steps_per_period}), got {S!r}")
+    if S > 1 and lyapunov_from is not None:
+        raise ValueError("the Lyapunov companion needs samples_per_period = 1")
     if not (np.isfinite(d0) and 0 < d0 < 1e-3):
         raise ValueError(f"d0 must be in (0, 1e-3), got {d0!r}")
     S0 = np.concatenate([PAPER_Z0, PAPER_DZ0]) if s0 is None else np.asarray(s0, dtype=float)
@@ -254,15 +262,17 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
                   k_slide, 0.0 if isinstance(ref, Circle) else 1.0])
     tab = dop853()
     T = ref.period
-    states, modes, logs, stats = run_periods(P, b, f, S0, int(n_periods), int(steps_per_period), T, 0.0, lf,
-                                                float(d0), tab.A, tab.b / tab.b_den, tab.c)
+    # with S samples per period the kernel's "period" is T / S: the reference is T-periodic,
+    # the kernel only needs the sampling interval and the steps within it
+    states, modes, logs, stats = run_periods(P, b, f, S0, int(n_periods) * S, int(steps_per_period) // S, T / S,
+                                             0.0, lf, float(d0), tab.A, tab.b / tab.b_den, tab.c)
     bad = np.flatnonzero(stats[:, 4] != 0)
     if bad.size:
         q = int(bad[0])
         why = "events accumulated (more than 200 in one step)" if stats[q, 4] == 1 else "the state became non-finite"
         raise RuntimeError(f"switched run {q} (angle limit {np.degrees(b[q]):.6g} deg, force limit {f[q]:g} N): "
                            f"{why}")
-    t = np.arange(n_periods + 1) * T
+    t = np.arange(n_periods * S + 1) * (T / S)
     err = error_state(ref, np.tile(t, b.size), states.reshape(-1, 6)).reshape(states.shape)
     return SwitchedRuns(angle_limit=b, force_limit=f, period=T, t=t, states=states, errors=err, mode_end=modes,
                         log_growth=logs, lyapunov_from=lf, crossings=stats[:, 0].astype(int),
@@ -358,49 +368,88 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
 
 
 def _locate_orbits(body, gains, ref, runs: SwitchedRuns, k_cand, o, steps_per_period):
-    """Newton on P^k for every run with a candidate lag k > 0, all runs at once: the
-    Jacobian by forward differences (6 extra runs per candidate). Returns
-    {run: dict(converged, mu (largest Floquet modulus), turns, reach)}."""
-    idx = np.flatnonzero(k_cand > 0)
-    if idx.size == 0:
-        return {}
-    K = int(k_cand[idx].max())
-    x = runs.states[idx, -1].copy()
-    x[:, 2] = np.mod(x[:, 2], 2 * np.pi)     # the map commutes with whole turns of phi
-    b, f, kq = runs.angle_limit[idx], runs.force_limit[idx], k_cand[idx]
+    """Newton on P^k for every run with a candidate lag k > 0, the runs of one k at once and
+    only those not yet converged: the Jacobian by forward differences (6 extra runs per
+    candidate and iteration). Returns {run: dict(converged, mu (largest Floquet modulus),
+    turns, reach, orbit)}."""
+    out = {}
     h = o["fd_step"]
     E = np.eye(6)
-    n = idx.size
-    done = np.zeros(n, dtype=bool)
-    res_norm = np.full(n, np.inf)
-    J = np.zeros((n, 6, 6))
-    turns = np.zeros(n, dtype=int)
-    for _ in range(12):
-        starts = np.concatenate([x[:, None, :], x[:, None, :] + h * E[None]], axis=1).reshape(-1, 6)
-        out = switched_runs(body, gains, ref, np.repeat(b, 7), np.repeat(f, 7), s0=starts, n_periods=K,
-                            steps_per_period=steps_per_period).states
-        Pk = out[np.arange(7 * n), np.repeat(kq, 7)].reshape(n, 7, 6)
-        turns = np.rint((Pk[:, 0, 2] - x[:, 2]) / (2 * np.pi)).astype(int)
-        shift = np.zeros((n, 6))
-        shift[:, 2] = 2 * np.pi * turns
-        r = Pk[:, 0] - x - shift
-        res_norm = np.abs(r).max(axis=1)
-        J = np.moveaxis((Pk[:, 1:] - Pk[:, :1]) / h, 1, 2)             # J[:, :, j] = d P^k / d x_j
-        done = res_norm < o["newton_tol"]
-        if done.all():
-            break
-        step = np.linalg.solve(J - np.eye(6)[None], -r[..., None])[..., 0]
-        step *= np.minimum(1.0, 0.1 / np.maximum(np.abs(step).max(axis=1), 1e-300))[:, None]
-        x = np.where(done[:, None], x, x + step)
-    mu = np.abs(np.linalg.eigvals(J)).max(axis=1)
-    # reach: the run's last section state against the orbit's k states (p modulo 2 pi)
-    orb = switched_runs(body, gains, ref, b, f, s0=x, n_periods=K, steps_per_period=steps_per_period)
-    out = {}
-    for j, q in enumerate(idx):
-        last = runs.states[q, -1]
-        pts = orb.states[j, :kq[j]]
-        d = last[None] - pts
-        d[:, 2] = wrap_angle(d[:, 2])
-        out[int(q)] = dict(converged=bool(done[j]), mu=float(mu[j]), turns=int(turns[j]),
-                           reach=float(np.abs(d).max(axis=1).min()), orbit=x[j])
+    for k in np.unique(k_cand[k_cand > 0]):
+        idx = np.flatnonzero(k_cand == k)
+        n = idx.size
+        x = runs.states[idx, -1].copy()
+        x[:, 2] = np.mod(x[:, 2], 2 * np.pi)     # the map commutes with whole turns of phi
+        b, f = runs.angle_limit[idx], runs.force_limit[idx]
+        done = np.zeros(n, dtype=bool)
+        J = np.full((n, 6, 6), np.nan)
+        turns = np.zeros(n, dtype=int)
+        for _ in range(10):
+            act = np.flatnonzero(~done)
+            if act.size == 0:
+                break
+            starts = np.concatenate([x[act, None, :], x[act, None, :] + h * E[None]], axis=1).reshape(-1, 6)
+            Pk = switched_runs(body, gains, ref, np.repeat(b[act], 7), np.repeat(f[act], 7), s0=starts,
+                               n_periods=int(k), steps_per_period=steps_per_period).states[:, -1].reshape(-1, 7, 6)
+            turns[act] = np.rint((Pk[:, 0, 2] - x[act, 2]) / (2 * np.pi)).astype(int)
+            r = Pk[:, 0] - x[act]
+            r[:, 2] -= 2 * np.pi * turns[act]
+            J[act] = np.moveaxis((Pk[:, 1:] - Pk[:, :1]) / h, 1, 2)        # J[:, :, j] = d P^k / d x_j
+            conv = np.abs(r).max(axis=1) < o["newton_tol"]
+            done[act[conv]] = True
+            go = act[~conv]
+            if go.size:
+                step = np.linalg.solve(J[go] - np.eye(6)[None], -r[~conv, :, None])[..., 0]
+                step *= np.minimum(1.0, 0.1 / np.maximum(np.abs(step).max(axis=1), 1e-300))[:, None]
+                x[go] += step
+        mu = np.abs(np.linalg.eigvals(np.nan_to_num(J))).max(axis=1)
+        # reach: the run's last section state against the orbit's k states (phi modulo 2 pi)
+        orb = switched_runs(body, gains, ref, b, f, s0=x, n_periods=int(k), steps_per_period=steps_per_period)
+        for j, q in enumerate(idx):
+            d = runs.states[q, -1][None] - orb.states[j, :k]
+            d[:, 2] = wrap_angle(d[:, 2])
+            out[int(q)] = dict(converged=bool(done[j]), mu=float(mu[j]), turns=int(turns[j]),
+                               reach=float(np.abs(d).max(axis=1).min()), orbit=x[j].copy())
     return out
+
+
+#: how many times longer :func:`extend_undecided` runs the points left undecided
+UNDECIDED_FACTOR = 8
+
+
+def extend_undecided(body: Body, gains: Gains, ref: Reference, frame: pd.DataFrame,
+                     factor: int = UNDECIDED_FACTOR, *,
+                     s0=None, steps_per_period: int = STEPS_PER_PERIOD, **options) -> pd.DataFrame:
+    """Decide the undecided rows of ``frame`` (:func:`limit_verdicts`) again over a horizon
+    ``factor`` times longer (the section and the Lyapunov run, and the blocks of the
+    standard error with them; the same transient and start). On an invariant torus the
+    log-growth of a separation is bounded, so its mean falls as 1 / horizon, and with
+    blocks ``factor`` times longer so does its standard error: a longer horizon resolves a
+    zero exponent where a chaotic one stays positive. Returns a copy of ``frame`` with
+    those rows replaced and a column ``horizon`` (periods of section and Lyapunov run)."""
+    o = {**LIMIT_DEFAULTS, **options}
+    out = frame.copy()
+    out["horizon"] = o["periods"]
+    todo = np.flatnonzero((frame.regime == "undecided").to_numpy())
+    if todo.size == 0:
+        return out
+    long = {**o, "periods": o["periods"] * factor, "block": o["block"] * factor}
+    redo, _ = limit_verdicts(body, gains, ref, frame.angle_limit.to_numpy()[todo],
+                             frame.force_limit.to_numpy()[todo], s0=s0, steps_per_period=steps_per_period, **long)
+    redo["horizon"] = long["periods"]
+    redo.index = frame.index[todo]
+    out.loc[redo.index, redo.columns] = redo
+    return out
+
+
+def regime_edges(frame: pd.DataFrame, regime: str = "chaotic") -> pd.DataFrame:
+    """Where a sweep over the angle limit enters or leaves ``regime``: for each force limit
+    of ``frame`` (:func:`limit_verdicts`), the pairs of neighbouring angle limits (rad)
+    with ``regime`` on one side only. Columns force_limit, lo, hi, below, above (the
+    regimes at lo and at hi)."""
+    rows = []
+    for cap, g in frame.sort_values("angle_limit").groupby("force_limit", sort=True):
+        a, r = g.angle_limit.to_numpy(), g.regime.to_numpy()
+        for i in np.flatnonzero((r[:-1] == regime) != (r[1:] == regime)):
+            rows.append(dict(force_limit=cap, lo=a[i], hi=a[i + 1], below=r[i], above=r[i + 1]))
+    return pd.DataFrame(rows, columns=["force_limit", "lo", "hi", "below", "above"])

@@ -16,7 +16,7 @@ from .params import Body
 
 __all__ = ["body_outline", "draw_body", "new_axes", "plot_path", "plot_errors", "plot_force", "plot_bifurcation",
            "plot_section", "plot_fig5", "plot_fig5_exponents", "plot_circle_map", "plot_heading_orbits",
-           "REGIME_COLORS"]
+           "REGIME_COLORS", "LIMIT_COLORS", "plot_limit_sweep", "plot_limit_map"]
 
 
 def new_axes(ax=None, **subplot_kw):
@@ -245,4 +245,57 @@ def plot_heading_orbits(orbits: dict, t, p, distances: dict, multiplier: float):
     b.semilogy(j, d_last[-1] * multiplier ** (j - j[-1]), "k:", label=r"$|\mu_1|^j$")
     b.set(xlabel="period $j$", ylabel="largest $|p - p_{orbit}|$ over the period (rad)", title="(b)")
     b.legend(fontsize=8)
+    return fig
+
+
+#: colours of the regimes of :func:`lib.limits.limit_verdicts` on Chapter 4's figures
+LIMIT_COLORS = {"periodic": "C2", **REGIME_COLORS}
+
+
+def plot_limit_sweep(frame: pd.DataFrame, sections, *, axes, column: int = 4,
+                     label: str = r"$p$ at $t=kT$ (rad)", title: str | None = None):
+    """A bifurcation diagram over the angle limit with the largest Lyapunov exponent beneath
+    it, on two axes sharing the angle axis: ``axes`` = (top, bottom). Top: the chosen column
+    of each run's section (error states at t = kT, ``sections`` (N, L, 6)), coloured by the
+    regime in ``frame`` (:func:`lib.limits.limit_verdicts`); bottom: lambda_1 (1/s) with
+    +-3 standard errors, and zero. Returns the figure."""
+    top, bot = axes
+    deg = frame.angle_deg.to_numpy()
+    for regime, color in LIMIT_COLORS.items():
+        sel = (frame.regime == regime).to_numpy()
+        if sel.any():
+            L = sections.shape[1]
+            top.plot(np.repeat(deg[sel], L), sections[sel, :, column].ravel(), ".", ms=1.5, color=color,
+                     label=f"{regime} ({int(sel.sum())})")
+            bot.errorbar(deg[sel], frame.lyapunov[sel], yerr=3 * frame.lyapunov_stderr[sel], fmt="o", ms=2.5,
+                         color=color, elinewidth=0.8)
+    bot.axhline(0.0, color="k", lw=0.6)
+    top.set(ylabel=label, title=title)
+    top.legend(fontsize=7, markerscale=5, loc="upper right")
+    bot.set(xlabel=r"angle limit $\beta_{max}$ (deg)", ylabel=r"$\lambda_1$ (1/s), $\pm 3$ SE")
+    return top.figure
+
+
+def plot_limit_map(frame: pd.DataFrame, *, ax=None):
+    """Regime map over (angle limit, force cap) from :func:`lib.limits.limit_verdicts`: one
+    cell per run, coloured by regime, periodic cells labelled with their period; the
+    uncapped runs (force_limit inf) form the top row. Returns the figure."""
+    fig, ax = new_axes(ax, figsize=(8, 4))
+    caps = np.sort(frame.force_limit.unique())
+    angles = np.sort(frame.angle_deg.unique())
+    names = list(LIMIT_COLORS)
+    code = np.full((caps.size, angles.size), np.nan)
+    for r in frame.itertuples():
+        i, j = np.searchsorted(caps, r.force_limit), np.searchsorted(angles, r.angle_deg)
+        code[i, j] = names.index(r.regime)
+        if r.regime in ("periodic", "slipping"):
+            ax.text(j, i, str(r.period), ha="center", va="center", fontsize=7, color="w")
+    ax.imshow(code, origin="lower", aspect="auto", cmap=ListedColormap([LIMIT_COLORS[n] for n in names]),
+              vmin=-0.5, vmax=len(names) - 0.5, interpolation="nearest")
+    ax.set_xticks(range(angles.size), [f"{a:g}" for a in angles], fontsize=7)
+    ax.set_yticks(range(caps.size), ["none" if not np.isfinite(c) else f"{c:g}" for c in caps], fontsize=8)
+    ax.set(xlabel=r"angle limit $\beta_{max}$ (deg)", ylabel=r"force cap $F_{max}$ (N)")
+    counts = frame.regime.value_counts()
+    ax.legend(handles=[Patch(color=LIMIT_COLORS[n], label=f"{n} ({counts[n]})") for n in names if n in counts],
+              loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=5, fontsize=8)
     return fig

@@ -15,8 +15,10 @@ modes (+1 / -1 smooth on a side, 0 sliding), by a different scheme:
   exits r_+ + k lat (rising) and r_- + k lat (falling), and the kinks
   |tau| sin(psi -+ beta_max) and |tau|^2 - F_max^2 (either way). If one changed
   sign, the step is redone from its start with a shorter step, the length
-  found by the Illinois method on the event function (every third try a
-  bisection), until the first event is bracketed to ``1e-11`` s. The run then
+  found by the Illinois method on the event function (a bisection when it
+  stalls), until the first event is bracketed to 1e-11 s (a switching or a
+  slide exit, where the field jumps) or 1e-8 s (a kink, where only its
+  derivative does). The run then
   lands just past the event, so that no step straddles a switching or a kink,
   and the step's remainder follows with the new mode. No state is interpolated;
 - the mode after a crossing of S is decided as in ``SwitchedLoop``: cross if the
@@ -46,7 +48,8 @@ EPS_LAT = 1e-9
 #: number of event functions per mode (switching or exits, two clip kinks, the cap)
 N_EVENTS = 4
 _TWO_PI = 2.0 * math.pi
-_T_TOL = 1e-11
+_T_TOL = 1e-11         # a jump of the field (switching, slide exit): located to 1e-11 s
+_T_TOL_KINK = 1e-8     # a kink (a jump of its derivative): straddling 1e-8 s costs O(1e-16)
 _MAX_EVENTS_PER_STEP = 200
 
 # layout of the parameter vector P
@@ -224,10 +227,14 @@ def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2
                 g2[k] = g1[k]
             side = 0
             it = 0
-            while hi - lo > _T_TOL and it < 200:
+            stall = 0
+            tol = _T_TOL if (ev == 0 or mode == 0) else _T_TOL_KINK
+            while hi - lo > tol and it < 200:
                 it += 1
-                if it % 3 == 0 or ghi == glo:
+                width = hi - lo
+                if stall >= 2 or ghi == glo:
                     th = 0.5 * (lo + hi)
+                    stall = 0
                 else:
                     th = (lo * ghi - hi * glo) / (ghi - glo)
                     if not (lo < th < hi):
@@ -259,6 +266,8 @@ def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2
                     if side == -1:
                         ghi *= 0.5
                     side = -1
+                stall = stall + 1 if hi - lo > 0.5 * width else 0
+                tol = _T_TOL if (ev == 0 or mode == 0) else _T_TOL_KINK
             if mode == 0:
                 stats[2] += hi
             t += hi

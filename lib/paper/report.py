@@ -29,7 +29,7 @@ from ..circle_rotation import (circle_critical_radius, circle_eigenvalues, circl
 from ..allocation import Limits
 from ..control import allocate, allocate_least_squares, error_dynamics_solution
 from ..controllability import free_lie_rank, paper_bracket_count
-from ..limits import sweep_angle_limit
+from ..limits import extend_undecided, limit_verdicts
 from ..model import f, generalized_force
 from ..params import Body, Gains
 from ..rotation_verdicts import eight_rotation_sweep, map_summary, rotation_attractor
@@ -271,13 +271,20 @@ def _check_fig4() -> Outcome:
 
 
 def _check_chaos() -> Outcome:
-    reg = sweep_angle_limit(Body(), Gains(), eight(), np.radians([20.0]), n_transient=15, n_points=16,
-                            n_lyap=48, rtol=1e-8, atol=1e-8)[0]
-    # chaotic with a margin: twice the 3-standard-error threshold (measured 9-11 standard errors)
-    ok = reg.verdict == "chaotic" and reg.lyapunov > 6 * reg.lyapunov_stderr
-    return Outcome(_status(ok, "reproduced"), reg.lyapunov,
-                   "largest Lyapunov exponent (1/s), angle limit 20 deg, eight",
-                   "chaos found at small angle limits; no quasi-periodic regime was found (Chapter 4)")
+    # the paper's "quasi-periodic or chaotic": both decided on the eight by Chapter 4's verdicts.
+    # Chaos at 30 deg without a cap by more than 6 standard errors (measured 15-19); the
+    # quasi-periodic motion at 37 deg with a 6 N cap over the longer horizon, every criterion met
+    # by a factor 1.3 or more (measured |lambda T| 0.002, 3 SE T 0.0044, returns 0.0015)
+    body, gains, ref = Body(), Gains(), eight()
+    chaos = limit_verdicts(body, gains, ref, np.radians([30.0]))[0].iloc[0]
+    qp = extend_undecided(body, gains, ref, limit_verdicts(body, gains, ref, np.radians([37.0]), 6.0)[0]).iloc[0]
+    ok = (chaos.regime == "chaotic" and chaos.lyapunov > 6 * chaos.lyapunov_stderr and qp.regime == "quasiperiodic"
+          and abs(qp.lyapunov) * ref.period < 0.0075 and 3 * qp.lyapunov_stderr * ref.period < 0.0075)
+    return Outcome(_status(ok, "reproduced"), chaos.lyapunov,
+                   "largest Lyapunov exponent (1/s), angle limit 30 deg, eight",
+                   "both occur: chaos at small and moderate angle limits without a cap; quasi-periodic motion "
+                   "with a force cap too (37 deg with 6 N); under the 4 N cap of Fig. 4 the angle limit mostly "
+                   "leaves the motion periodic (Chapter 4)")
 
 
 # ------------------------------------------------------------------ Sec. 6
