@@ -660,9 +660,9 @@ class MapComparison:
     @property
     def cross(self) -> pd.DataFrame:
         """Points by the paper's law (rows: heading held / lost) against the weighted law
-        (columns: held, heading lost (body on the path), position lost, and periodic-or-not)."""
+        (columns: neither lost, heading lost (body on the path), position lost)."""
         wl = np.where(self.weighted.position_lost, "position lost",
-                      np.where(self.weighted.lost, "heading lost", "heading held"))
+                      np.where(self.weighted.lost, "heading lost", "neither lost"))
         pl = np.where(self.lost, "lost", "held")
         return pd.crosstab(pd.Series(pl, name="paper's law"), pd.Series(wl, name="weighted law"))
 
