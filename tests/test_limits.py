@@ -9,6 +9,7 @@ from lib import limits as L, trajectories as T
 from lib.params import Body, Gains
 from lib.allocation import Limits
 from lib.closed_loop import ClosedLoop, reference_of
+from lib.integrators import switched_compiled
 from lib.control import computed_torque, computed_torque_rate
 from lib.model import config_accel
 from lib.simulate import Integration, simulate
@@ -242,13 +243,15 @@ def test_switched_loop_scalar_fast_path_is_eqs_23_and_2_4(t, s, kind, F, beta):
 
 @pytest.mark.parametrize("deg, cap", [(45, None), (20, None), (30, 4.0), (60, 3.0)])
 def test_compiled_switched_runs_match_the_event_located_reference(deg, cap):
-    # three periods through crossings, a slide (45 deg), the cap's kinks (30 deg / 4 N): the
-    # compiled fixed-step integrator against SwitchedLoop at rtol = atol = 1e-11. Measured
-    # differences 4e-9 to 6e-7 (the latter at 20 deg, where the motion is already stretching)
+    # three periods (two at 20 deg, where the chaotic motion stretches errors by e^(0.3 t))
+    # through crossings, a slide (45 deg), the cap's kinks (30 deg / 4 N): the compiled
+    # fixed-step integrator against SwitchedLoop at rtol = atol = 1e-11. Measured
+    # differences 4e-9 to 5e-8, and 1e-7 at 20 deg
     ref = T.eight()
     b = np.radians(deg)
-    runs = L.switched_runs(Body(), Gains(), ref, b, cap, n_periods=3, steps_per_period=400)
-    seg = L.SwitchedLoop(Body(), Gains(), ref, b, cap).integrate(S0, 0.0, 3 * ref.period, rtol=1e-11, atol=1e-11)
+    n = 2 if deg == 20 else 3
+    runs = L.switched_runs(Body(), Gains(), ref, b, cap, n_periods=n, steps_per_period=400)
+    seg = L.SwitchedLoop(Body(), Gains(), ref, b, cap).integrate(S0, 0.0, n * ref.period, rtol=1e-11, atol=1e-11)
     assert np.abs(runs.states[0, -1] - seg.y_end).max() < 1e-5
     assert (runs.crossings[0], runs.slides[0]) == (seg.n_crossings, seg.n_slides)
     assert abs(runs.t_sliding[0] - seg.t_sliding) < 1e-6
@@ -319,3 +322,28 @@ def test_switched_runs_reject_bad_input():
         L.limit_verdicts(Body(), Gains(), ref, 0.5, transients=3)
     with pytest.raises(RuntimeError, match="non-finite"):
         L.switched_runs(Body(), Gains(), ref, 0.5, s0=[0, 0, 0, 1e308, 0, 0], n_periods=1)
+
+
+@settings(max_examples=200, deadline=None)
+@given(t=st_.floats(0.0, 50.0), s=st_.lists(st_.floats(-5.0, 5.0), min_size=6, max_size=6),
+       kind=st_.sampled_from(["circle", "eight"]), bdeg=st_.floats(5.0, 180.0), cap=st_.sampled_from([np.inf, 3.0]))
+def test_compiled_field_is_the_closed_loop_with_its_limits(t, s, kind, bdeg, cap):
+    # the compiled kernel keeps its own scalar copy of (23), (2)-(4) and the clipped, capped
+    # allocation (without trigonometry for the clip); off the switching surface its field must
+    # be the library's closed loop (lib.closed_loop.ClosedLoop with lib.allocation.Limits),
+    # with beta_max = pi meaning no angle limit
+    ref = T.make(kind, 1.7, 0.6)
+    b, g = Body(), Gains()
+    P = np.array([b.m, b.I, b.a, b.c, b.c_phi, g.kp[0], g.kp[1], g.kv[0], g.kv[1], ref.R, ref.theta, 5.0,
+                  0.0 if kind == "circle" else 1.0])
+    bmax = min(math.radians(bdeg), math.pi)
+    s = np.array(s)
+    out, ev = np.empty(6), np.empty(4)
+    lat, lon = switched_compiled._field(P, (bmax, math.cos(bmax), math.sin(bmax), cap), 1, t, s, out, ev)
+    if abs(lat) < 1e-6 and lon < 0:
+        return          # on the switching surface each side's field is a continuation
+    mode = 1 if lat > 0 else -1
+    switched_compiled._field(P, (bmax, math.cos(bmax), math.sin(bmax), cap), mode, t, s, out, ev)
+    lim = Limits(force=None if not np.isfinite(cap) else cap, angle=None if bmax >= math.pi else bmax)
+    want = ClosedLoop.of(b, g, reference_of(ref), limits=lim).rates(t, s)[0]
+    np.testing.assert_allclose(out, want, rtol=1e-10, atol=1e-10)
