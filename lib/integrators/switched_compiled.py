@@ -14,9 +14,10 @@ modes (+1 / -1 smooth on a side, 0 sliding), by a different scheme:
   function mode * lat + eps_lat (watched falling through zero), the sliding
   exits r_+ + k lat (rising) and r_- + k lat (falling), and the kinks
   |tau| sin(psi -+ beta_max) and |tau|^2 - F_max^2 (either way). If one changed
-  sign, the step is redone from its start with a shorter step, the length
-  found by the Illinois method on the event function (a bisection when it
-  stalls), until the first event is bracketed to 1e-11 s (a switching or a
+  sign, the step is redone from its start with a shorter step: its root is
+  first estimated on the step's cubic Hermite interpolant and bracketed by two
+  real steps 1e-3 of the step either side, then the length is found by the
+  Illinois method on the event function (a bisection when it stalls), until the first event is bracketed to 1e-11 s (a switching or a
   slide exit, where the field jumps) or 1e-8 s (a kink, where only its
   derivative does). The run then
   lands just past the event, so that no step straddles a switching or a kink,
@@ -190,9 +191,32 @@ def _initial_mode(P, lim, t, s, g, tmp):
 
 
 @numba.njit(cache=True)
-def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2, stats):
+def _hermite_root(P, lim, mode, t, dt, s, f0, y1, f1, g0, ev, yh, fh, gh):
+    """Root in (0, dt) of event ``ev`` (as :func:`_fired` sees it from ``g0``) on the cubic
+    Hermite interpolant of the step (t, s, f0) -> (t + dt, y1, f1), by bisection to 1e-10 dt:
+    an estimate, to be bracketed by real steps (the interpolant's error is of the step's order
+    four, not eight). ``f1`` must hold the rates at the step's end. Returns -1 if none is seen."""
+    lo, hi = 0.0, 1.0
+    found = False
+    for _ in range(34):
+        u = 0.5 * (lo + hi)
+        u2, u3 = u * u, u * u * u
+        h00, h10, h01, h11 = 2 * u3 - 3 * u2 + 1, u3 - 2 * u2 + u, -2 * u3 + 3 * u2, u3 - u2
+        for q in range(6):
+            yh[q] = h00 * s[q] + h10 * dt * f0[q] + h01 * y1[q] + h11 * dt * f1[q]
+        _field(P, lim, mode, t + u * dt, yh, fh, gh)
+        if _fired(mode, g0, gh, ev):
+            hi = u
+            found = True
+        else:
+            lo = u
+    return hi * dt if found else -1.0
+
+
+@numba.njit(cache=True)
+def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2, yh, fh, gh, stats):
     """Integrate s (in place) over n_steps steps of size h from t0; returns the final mode.
-    stats: [crossings, slides, time sliding, events, failed]."""
+    stats: [crossings, slides, time sliding, events, failed, steps locating events]."""
     _field(P, lim, mode, t0, s, ys, g0)
     for j in range(n_steps):
         t = t0 + j * h
@@ -217,7 +241,7 @@ def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2
                     g0[k] = g1[k]
                 t = t_end
                 break
-            # bracket the first event in (lo, hi]: Illinois on the target event, every third try a bisection
+            # bracket the first event in (lo, hi]
             lo, hi = 0.0, dt
             ev = first
             glo, ghi = g0[ev], g1[ev]
@@ -225,21 +249,60 @@ def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2
                 y2[q] = y1[q]
             for k in range(N_EVENTS):
                 g2[k] = g1[k]
+            # first on the step's cubic Hermite interpolant (one field evaluation per try), then
+            # two real steps a little before and after its root narrow the bracket cheaply
+            guess = _hermite_root(P, lim, mode, t, dt, s, K[0], y1, ys, g0, ev, yh, fh, gh)
+            if 0.0 < guess < dt:
+                for th in (guess - 1e-3 * dt, guess + 1e-3 * dt):
+                    if not lo < th < hi:
+                        continue
+                    _step(P, lim, mode, t, s, th, A, b, c, K, ys, y1, g1)
+                    stats[5] += 1
+                    hit = -1
+                    for k in range(N_EVENTS):
+                        if _fired(mode, g0, g1, k):
+                            hit = k
+                            break
+                    if hit >= 0:
+                        hi = th
+                        for q in range(6):
+                            y2[q] = y1[q]
+                        for k in range(N_EVENTS):
+                            g2[k] = g1[k]
+                        if hit != ev:
+                            ev = hit
+                            glo = g0[ev]
+                        ghi = g1[ev]
+                        break
+                    lo = th
+                    glo = g1[ev]
+            # then Illinois on the target event with real steps (a bisection when it stalls); a
+            # secant try that lands next to the root is followed by a try just across it, 0.9 tol
+            # away, which closes the bracket at once when the secant was accurate
             side = 0
             it = 0
             stall = 0
+            nudge = 0
             tol = _T_TOL if (ev == 0 or mode == 0) else _T_TOL_KINK
             while hi - lo > tol and it < 200:
                 it += 1
                 width = hi - lo
-                if stall >= 2 or ghi == glo:
+                secant = False
+                if nudge == 1:
+                    th = lo + 0.9 * tol
+                elif nudge == -1:
+                    th = hi - 0.9 * tol
+                elif stall >= 2 or ghi == glo:
                     th = 0.5 * (lo + hi)
                     stall = 0
                 else:
                     th = (lo * ghi - hi * glo) / (ghi - glo)
+                    secant = True
                     if not (lo < th < hi):
                         th = 0.5 * (lo + hi)
+                        secant = False
                 _step(P, lim, mode, t, s, th, A, b, c, K, ys, y1, g1)
+                stats[5] += 1
                 hit = -1
                 for k in range(N_EVENTS):
                     if _fired(mode, g0, g1, k):
@@ -260,12 +323,14 @@ def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2
                     if side == 1:
                         glo *= 0.5
                     side = 1
+                    nudge = -1 if secant else 0
                 else:
                     lo = th
                     glo = g1[ev]
                     if side == -1:
                         ghi *= 0.5
                     side = -1
+                    nudge = 1 if secant else 0
                 stall = stall + 1 if hi - lo > 0.5 * width else 0
                 tol = _T_TOL if (ev == 0 or mode == 0) else _T_TOL_KINK
             if mode == 0:
@@ -315,10 +380,11 @@ def _run(P, bmax, fmax, S0, n_periods, n_steps, T, t0, lyap_from, d0, A, b, c, s
         n_st = c.size
         K = np.empty((n_st, 6))
         ys, y1, y2 = np.empty(6), np.empty(6), np.empty(6)
-        g0, g1, g2 = np.empty(N_EVENTS), np.empty(N_EVENTS), np.empty(N_EVENTS)
+        g0, g1, g2, gh = np.empty(N_EVENTS), np.empty(N_EVENTS), np.empty(N_EVENTS), np.empty(N_EVENTS)
+        yh, fh = np.empty(6), np.empty(6)
         s = S0[q].copy()
         s2 = np.empty(6)
-        st2 = np.zeros(5)
+        st2 = np.zeros(6)
         h = T / n_steps
         lim = (bmax[q], math.cos(bmax[q]), math.sin(bmax[q]), fmax[q])
         mode = _initial_mode(P, lim, t0, s, g0, ys)
@@ -331,13 +397,13 @@ def _run(P, bmax, fmax, S0, n_periods, n_steps, T, t0, lyap_from, d0, A, b, c, s
                 for q6 in range(6):
                     s2[q6] = s[q6] + d0 / math.sqrt(6.0)
                 mode2 = _initial_mode(P, lim, ta, s2, g0, ys)
-            mode = _advance(P, lim, mode, ta, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2,
+            mode = _advance(P, lim, mode, ta, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2, yh, fh, gh,
                             stats[q])
             if stats[q, 4] != 0.0:
                 break
             if k >= lyap_from >= 0:
                 mode2 = _advance(P, lim, mode2, ta, s2, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1,
-                                 g2, st2)
+                                 g2, yh, fh, gh, st2)
                 if st2[4] != 0.0:
                     stats[q, 4] = st2[4]
                     break
@@ -361,14 +427,14 @@ def run_periods(P: np.ndarray, angle_limits: np.ndarray, force_limits: np.ndarra
     of ``n_periods`` periods from states S0 (N, 6) at t0. Returns the states at the period
     ends (N, n_periods + 1, 6), the final modes (N,), log(d/d0) of the companion per
     period from ``lyapunov_from`` on (N, n_periods - lyapunov_from; -1 for none) and the
-    statistics (N, 5): crossings, slides, time sliding (s), events, failure flag
-    (1: an accumulation of events, 2: a non-finite state)."""
+    statistics (N, 6): crossings, slides, time sliding (s), events, failure flag
+    (1: an accumulation of events, 2: a non-finite state), real steps spent locating events."""
     N = S0.shape[0]
     sections = np.full((N, n_periods + 1, 6), np.nan)
     modes = np.zeros(N, dtype=np.int64)
     n_log = n_periods - lyapunov_from if lyapunov_from >= 0 else 0
     logs = np.full((N, max(n_log, 0)), np.nan)
-    stats = np.zeros((N, 5))
+    stats = np.zeros((N, 6))
     _run(np.ascontiguousarray(P, float), np.ascontiguousarray(angle_limits, float),
          np.ascontiguousarray(force_limits, float), np.ascontiguousarray(S0, float), int(n_periods),
          int(steps_per_period), float(period), float(t0), int(lyapunov_from), float(d0),
