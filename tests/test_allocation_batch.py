@@ -128,3 +128,22 @@ def test_batch_allocation_and_limits_are_validated():
         weighting.closed_loop_batch(**args, allocation="exact")
     with pytest.raises(TypeError, match="limits must be a lib.allocation.Limits"):
         weighting.closed_loop_batch(**args, limits=(4.0, 1.0))
+
+
+def test_chapter_6_limits_comparison_is_converged_in_the_step_and_its_directions_hold():
+    # Chapter 6 runs Fig. 4's setting at dt = 40 ms across the switches of beta; halving the
+    # step moves its measures by far less than the exact-minus-projection gaps it reads
+    from lib.params import PAPER_DZ0, PAPER_Z0
+
+    sets = {"cap": Limits(4.0), "cap_angle": Limits(4.0, np.pi / 3)}
+    runs = [weighting.limits_comparison(Body(), Gains(), "eight", 2.0, np.pi / 4, (1.0, 1.0, 1.0), sets, periods=3,
+                                        dt=dt, z0=PAPER_Z0, dz0=PAPER_DZ0).set_index(["limits", "law"])
+            for dt in (0.04, 0.02)]
+    for col in ("pos_rms", "p_rms"):
+        assert (runs[0][col] - runs[1][col]).abs().max() < 0.003
+    for r in runs:
+        for s in sets:
+            assert r.loc[(s, "exact"), "p_rms"] < r.loc[(s, "projection"), "p_rms"] - 0.003
+            assert r.loc[(s, "exact"), "pos_rms"] > r.loc[(s, "projection"), "pos_rms"] + 0.01
+    with pytest.raises(ValueError, match="periods must be an integer"):
+        weighting.limits_comparison(Body(), Gains(), "eight", 2.0, 1.0, (1, 1, 1), sets, periods=1)
