@@ -14,7 +14,6 @@ runs at once, about a hundred times faster: :func:`switched_runs`,
 
 from __future__ import annotations
 
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,6 +24,7 @@ from .dynamics.lyapunov import LyapunovEstimate, largest_lyapunov
 from .dynamics.sections import distinct_points, section_margin, section_period
 from .integrators.batch import dop853
 from .integrators.switched import Segments, SwitchedLoop
+from .parallel import map_in_processes
 from .params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from .rotation_verdicts import section_returns
 from .trajectories import Circle, Eight, Reference
@@ -101,13 +101,6 @@ def classify(period: int, lyapunov: float, stderr: float, *, zero_band: float = 
     return "undecided"
 
 
-def _map(fn, items, workers: int):
-    if workers <= 1 or len(items) <= 1:
-        return [fn(x) for x in items]
-    with ProcessPoolExecutor(max_workers=workers) as ex:
-        return list(ex.map(fn, items))
-
-
 def _section_one(args):
     body, gains, ref, bmax, force_limit, n_transient, n_points, rtol, atol, s0 = args
     loop = SwitchedLoop(body, gains, ref, bmax, force_limit)
@@ -125,7 +118,7 @@ def section_sweep(body: Body, gains: Gains, ref: Reference, angle_limits, *, for
                          np.asarray(PAPER_DZ0 if dz0 is None else dz0, dtype=float)])
     items = [(body, gains, ref, float(b), force_limit, n_transient, n_points, rtol, atol, s0)
              for b in np.atleast_1d(np.asarray(angle_limits, dtype=float))]
-    return _map(_section_one, items, workers)
+    return map_in_processes(_section_one, items, workers)
 
 
 def sweep_angle_limit(body: Body, gains: Gains, ref: Reference, angle_limits, *, force_limit=None,
@@ -143,7 +136,7 @@ def sweep_angle_limit(body: Body, gains: Gains, ref: Reference, angle_limits, *,
                          np.asarray(PAPER_DZ0 if dz0 is None else dz0, dtype=float)])
     items = [(body, gains, ref, float(b), force_limit, n_transient, n_points, n_lyap, tol, rtol, atol, d0, s0)
              for b in np.atleast_1d(np.asarray(angle_limits, dtype=float))]
-    return _map(_regime_one, items, workers)
+    return map_in_processes(_regime_one, items, workers)
 
 
 def _regime_one(args) -> Regime:

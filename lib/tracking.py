@@ -21,6 +21,7 @@ from .closed_loop import ClosedLoop, reference_of
 from .integrators.smooth import integrate
 from .control import computed_torque, error_dynamics_solution
 from .limits import switched_runs
+from .parallel import map_in_processes
 from .params import Body, Gains
 from .simulate import Integration, SimulationResult, simulate
 from .trajectories import Reference, make
@@ -139,23 +140,27 @@ def refined_summary(body: Body, gains: Gains, res: SimulationResult, n_periods: 
 
 
 def eight_sensitivity(body: Body, gains: Gains, Rs, thetas, *, n_periods: float = 12.0,
-                      n_steady: float = 2.0) -> pd.DataFrame:
+                      n_steady: float = 2.0, workers: int = 1) -> pd.DataFrame:
     """Steady-state measures of eight tracking (:func:`steady_summary`) over a grid of
     radii R (m) and rates theta (rad/s); one row per (R, theta). A run whose rotation
     does not settle to a periodic motion shows a large ``p_range``. The run's end state
     is returned too, so that a verdict can continue it: ``p_end`` (rad, in (-pi, pi]),
     ``dp_end`` (rad/s), the heading error and its rate, and ``e_end`` (m), the largest
-    position error (the reduced rotation equation holds once it is negligible)."""
-    rows = []
-    for R in np.atleast_1d(Rs):
-        for th in np.atleast_1d(thetas):
-            res = run(body, gains, "eight", float(R), float(th), n_periods, samples_per_period=100,
-                      integration=Integration(rtol=1e-9, atol=1e-9))
-            rows.append({"R": float(R), "theta": float(th), **steady_summary(res, n_steady),
-                         "p_end": float(wrap_angle(res.rotation_error()[-1])),
-                         "dp_end": float(res.dz[-1, 2] - res.dz_d[-1, 2]),
-                         "e_end": float(np.abs(res.error[-1, :2]).max())})
-    return pd.DataFrame(rows)
+    position error (the reduced rotation equation holds once it is negligible).
+    ``workers`` processes share the runs."""
+    items = [(body, gains, float(R), float(th), n_periods, n_steady)
+             for R in np.atleast_1d(Rs) for th in np.atleast_1d(thetas)]
+    return pd.DataFrame(map_in_processes(_sensitivity_one, items, workers))
+
+
+def _sensitivity_one(args) -> dict:
+    body, gains, R, th, n_periods, n_steady = args
+    res = run(body, gains, "eight", R, th, n_periods, samples_per_period=100,
+              integration=Integration(rtol=1e-9, atol=1e-9))
+    return {"R": R, "theta": th, **steady_summary(res, n_steady),
+            "p_end": float(wrap_angle(res.rotation_error()[-1])),
+            "dp_end": float(res.dz[-1, 2] - res.dz_d[-1, 2]),
+            "e_end": float(np.abs(res.error[-1, :2]).max())}
 
 
 def saturated_intervals(t, F, cap: float, rel: float = 1e-9) -> list[tuple[float, float]]:
