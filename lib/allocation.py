@@ -206,7 +206,7 @@ def _limited(tau, phi, body: Body, sw, limits: Limits):
     return F.reshape(shape), beta.reshape(shape)
 
 
-def _arc_minima(G, r, fmax: float, bmax: float, n_samples: int = 129, n_newton: int = 6) -> list[np.ndarray]:
+def _arc_minima(G, r, fmax: float, bmax: float, n_samples: int = 129, n_newton: int = 5) -> list[np.ndarray]:
     """Points u = fmax (cos beta, sin beta), |beta| <= bmax, at the two best sampled local
     minima of J along the arc, each refined by safeguarded Newton on dJ/dbeta = 0 inside the
     bracket of its two neighbouring samples (bisection where Newton would leave it or J'' <= 0).
@@ -214,7 +214,7 @@ def _arc_minima(G, r, fmax: float, bmax: float, n_samples: int = 129, n_newton: 
     r2 sin beta), A0 = (G11 + G22) / 2, A1 = (G11 - G22) / 2, A2 = G12: a trigonometric
     polynomial of degree 2, with at most two local minima. Newton converges quadratically from
     a sample within one sample spacing (about 0.05 rad for bmax = pi): the error squares
-    at every step, so ``n_newton`` = 6 steps reach rounding; a Newton step that would leave the
+    at every step, so ``n_newton`` = 5 steps reach rounding; a Newton step that would leave the
     bracket, or J'' <= 0, is replaced by a bisection."""
     betas = np.linspace(-bmax, bmax, n_samples)
     E = np.stack([np.cos(betas), np.sin(betas)], axis=-1) * fmax

@@ -722,7 +722,8 @@ def limits_comparison(body: Body, gains: Gains, kind: str, R: float, Theta: floa
     """The weighted law under force and angle limits, met by projection
     (``allocation="least_squares"``) and exactly (``"limited"``), by :func:`closed_loop_batch`:
     for each named :class:`lib.allocation.Limits` in ``limits``, both runs over ``periods``
-    reference periods with RK4 step ``dt`` (s), and :func:`steady_metrics` over the last period.
+    reference periods with RK4 step ``dt`` (s), and :func:`steady_metrics` over the last period
+    (sampled every second step).
     Returns one row per (limits, law): the limits' name, ``law``, and the metrics' columns."""
     if not limits:
         raise ValueError("no limits given")
@@ -732,7 +733,7 @@ def limits_comparison(body: Body, gains: Gains, kind: str, R: float, Theta: floa
     rows = []
     for name, lim in limits.items():
         for law in ("least_squares", "limited"):
-            res = closed_loop_batch(body, gains, kind, R, Theta, weights, t_end=periods * T, dt=dt, record_dt=dt,
+            res = closed_loop_batch(body, gains, kind, R, Theta, weights, t_end=periods * T, dt=dt, record_dt=2 * dt,
                                     z0=z0, dz0=dz0, allocation=law, limits=lim)
             m = steady_metrics(res, n_periods=1.0).iloc[0].to_dict()
             rows.append({"limits": name, "law": "projection" if law == "least_squares" else "exact", **m})
