@@ -17,10 +17,9 @@ modes (+1 / -1 smooth on a side, 0 sliding), by a different scheme:
   sign, the step is redone from its start with a shorter step: its root is
   first estimated on the step's cubic Hermite interpolant and bracketed by two
   real steps 1e-3 of the step either side, then the length is found by the
-  Illinois method on the event function (a bisection when it stalls), until the first event is bracketed to 1e-11 s (a switching or a
-  slide exit, where the field jumps) or 1e-8 s (a kink, where only its
-  derivative does). The run then
-  lands just past the event, so that no step straddles a switching or a kink,
+  Illinois method on the event function (a bisection when it stalls),
+  until the first event is bracketed to 1e-11 s. The run then lands just past
+  the event, so that no step straddles a switching or a kink,
   and the step's remainder follows with the new mode. No state is interpolated;
 - the mode after a crossing of S is decided as in ``SwitchedLoop``: cross if the
   far side's field carries on through S, slide if both fields point into S.
@@ -49,8 +48,11 @@ EPS_LAT = 1e-9
 #: number of event functions per mode (switching or exits, two clip kinks, the cap)
 N_EVENTS = 4
 _TWO_PI = 2.0 * math.pi
-_T_TOL = 1e-11         # a jump of the field (switching, slide exit): located to 1e-11 s
-_T_TOL_KINK = 1e-8     # a kink (a jump of its derivative): straddling 1e-8 s costs O(1e-16)
+#: events are bracketed to 1e-11 s: switchings and slide exits (a jump of the field) and kinks
+#: (a jump of its derivative) alike. Kinks located to only 1e-8 s cost a factor 40 in the error
+#: of a chaotic run after two periods (measured: 2.5e-6 against 6e-8 at 20 deg, 400 steps)
+_T_TOL = 1e-11
+_T_TOL_KINK = 1e-11
 _MAX_EVENTS_PER_STEP = 200
 
 # layout of the parameter vector P
