@@ -274,7 +274,7 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
 
 #: regimes of :func:`limit_verdicts`, as Chapter 5 names them (:data:`lib.rotation_verdicts.REGIMES`)
 LIMIT_DEFAULTS = dict(transient=60, periods=120, block=12, max_period=8, candidate_tol=1e-3, newton_tol=1e-9,
-                      fd_step=1e-6, reach_tol=1e-3, lyapunov_band=0.01, return_tol=0.05)
+                      fd_step=1e-6, reach_tol=1e-3, approach_tol=0.05, lyapunov_band=0.01, return_tol=0.05)
 
 
 def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force_limits=None, *, s0=None,
@@ -289,12 +289,18 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
       Newton on P^k(x) = x + (0, 0, 2 pi n, 0, 0, 0), with the Jacobian by forward
       differences (step ``fd_step``), converges to ``newton_tol``; the orbit attracts
       (all Floquet multipliers, the eigenvalues of DP^k, inside the unit circle) and
-      the run's last section state is within ``reach_tol`` of it.
+      the run has reached it: its last section state is within ``reach_tol`` of it, or
+      within ``approach_tol`` and nearer than half-way through the section (a slowly
+      attracting orbit, as Chapter 5 allows).
     - **chaotic**: no such orbit and lambda T > max(3 SE T, ``lyapunov_band``), the
       largest Lyapunov exponent lambda (1/s) with its standard error SE from the means
       of blocks of ``block`` periods.
-    - **quasiperiodic**: no orbit, |lambda T| and 3 SE T below the band, and the section
-      closes on itself (:func:`lib.rotation_verdicts.section_returns` below ``return_tol``).
+    - **quasiperiodic**: no orbit, |lambda T| and 3 SE T below the band, the section
+      closes on itself (:func:`lib.rotation_verdicts.section_returns` below ``return_tol``),
+      and no *attracting* period-1 orbit lies inside the curve: Newton from the curve's
+      centre either finds none or finds one that repels (column floquet then holds its
+      largest |multiplier|, above 1, as where a torus is born from an orbit that lost
+      stability). An attracting one inside means a slow spiral onto it: undecided.
     - **undecided** otherwise, with the reason.
 
     Columns: angle_limit (rad), angle_deg, force_limit (N, inf for none), regime, period,
@@ -327,26 +333,38 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
         d[..., 4] = wrap_angle(d[..., 4])
         close = np.abs(d).max(axis=(1, 2)) < o["candidate_tol"]
         k_cand[close] = k
-    orbit = _locate_orbits(body, gains, ref, runs, k_cand, o, steps_per_period)
+    orbit = _locate_orbits(body, gains, ref, runs, k_cand, o, steps_per_period, ntr)
     returns = section_returns(np.moveaxis(sec, 0, 1), angles=(4,))
     band = o["lyapunov_band"]
+    lamT, seT = lam * T, se * T
+    # a closed-looking section with a zero exponent: is there an orbit inside the curve, and
+    # does it repel (the curve is an invariant torus) or attract (a slow spiral onto it)?
+    ring = np.flatnonzero((k_cand == 0) & (np.abs(lamT) < band) & (3 * seT < band) & (returns < o["return_tol"]))
+    inner_conv, inner_mu = np.zeros(N, dtype=bool), np.full(N, np.nan)
+    if ring.size:
+        inner_conv[ring], inner_mu[ring] = _enclosed_orbits(body, gains, ref, runs, ring, ntr, o, steps_per_period)
     rows = []
     for q in range(N):
         k, ob = int(k_cand[q]), orbit.get(q)
-        lamT, seT = lam[q] * T, se[q] * T
         regime, reason, period, turns, mu, x = "undecided", "", 0, 0, np.nan, None
-        if ob is not None and ob["converged"] and ob["mu"] < 1 and ob["reach"] < o["reach_tol"]:
+        reached = ob is not None and (ob["reach"] < o["reach_tol"] or (ob["reach"] < o["approach_tol"]
+                                                                        and ob["closing"]))
+        if ob is not None and ob["converged"] and ob["mu"] < 1 and reached:
             period, turns, mu, x = k, ob["turns"], ob["mu"], ob["orbit"]
             regime = "slipping" if turns else "periodic"
-        elif lamT > max(3 * seT, band):
+        elif lamT[q] > max(3 * seT[q], band):
             regime = "chaotic"
-        elif abs(lamT) < band and 3 * seT < band and returns[q] < o["return_tol"]:
+        elif q in ring and inner_conv[q] and inner_mu[q] < 1:
+            mu = inner_mu[q]
+            reason = f"slow spiral onto an attracting orbit inside the curve (|mu| = {inner_mu[q]:.4f})"
+        elif q in ring:
             regime = "quasiperiodic"
+            mu = inner_mu[q]      # the repelling orbit inside the torus, if found (NaN if not)
         elif ob is not None:
             mu = ob["mu"]
             reason = ("Newton did not converge" if not ob["converged"] else
                       f"orbit of period {k} not attracting" if ob["mu"] >= 1 else "orbit not reached")
-        elif abs(lamT) < band and 3 * seT < band:
+        elif abs(lamT[q]) < band and 3 * seT[q] < band:
             reason = "zero exponent, section does not close"
         else:
             reason = "exponent not resolved from zero"
@@ -360,50 +378,76 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
     return pd.DataFrame(rows), runs
 
 
-def _locate_orbits(body, gains, ref, runs: SwitchedRuns, k_cand, o, steps_per_period):
-    """Newton on P^k for every run with a candidate lag k > 0, the runs of one k at once and
-    only those not yet converged: the Jacobian by forward differences (6 extra runs per
-    candidate and iteration). Returns {run: dict(converged, mu (largest Floquet modulus),
-    turns, reach, orbit)}."""
-    out = {}
+def _newton_batch(body, gains, ref, b, f, x0, k: int, o, steps_per_period):
+    """Newton on P^k(x) = x + (0, 0, 2 pi n, 0, 0, 0) for runs with limits b, f (arrays) from
+    the states x0 (n, 6), all at once and only those not yet converged: the Jacobian by
+    forward differences (6 extra runs per run and iteration). (Each run has its own limits,
+    so :func:`lib.dynamics.orbits.newton_orbit`, which maps the points alone, does not fit.)
+    Returns (x, converged, largest Floquet modulus, turns n)."""
     h = o["fd_step"]
     E = np.eye(6)
+    x = np.array(x0, dtype=float)
+    x[:, 2] = np.mod(x[:, 2], 2 * np.pi)     # the map commutes with whole turns of phi
+    n = x.shape[0]
+    done = np.zeros(n, dtype=bool)
+    J = np.full((n, 6, 6), np.nan)
+    turns = np.zeros(n, dtype=int)
+    for _ in range(10):
+        act = np.flatnonzero(~done)
+        if act.size == 0:
+            break
+        starts = np.concatenate([x[act, None, :], x[act, None, :] + h * E[None]], axis=1).reshape(-1, 6)
+        Pk = switched_runs(body, gains, ref, np.repeat(b[act], 7), np.repeat(f[act], 7), s0=starts,
+                           n_periods=int(k), steps_per_period=steps_per_period).states[:, -1].reshape(-1, 7, 6)
+        turns[act] = np.rint((Pk[:, 0, 2] - x[act, 2]) / (2 * np.pi)).astype(int)
+        r = Pk[:, 0] - x[act]
+        r[:, 2] -= 2 * np.pi * turns[act]
+        J[act] = np.moveaxis((Pk[:, 1:] - Pk[:, :1]) / h, 1, 2)        # J[:, :, j] = d P^k / d x_j
+        conv = np.abs(r).max(axis=1) < o["newton_tol"]
+        done[act[conv]] = True
+        go = act[~conv]
+        if go.size:
+            step = np.linalg.solve(J[go] - np.eye(6)[None], -r[~conv, :, None])[..., 0]
+            step *= np.minimum(1.0, 0.1 / np.maximum(np.abs(step).max(axis=1), 1e-300))[:, None]
+            x[go] += step
+    mu = np.abs(np.linalg.eigvals(np.nan_to_num(J))).max(axis=1)
+    return x, done, mu, turns
+
+
+def _locate_orbits(body, gains, ref, runs: SwitchedRuns, k_cand, o, steps_per_period, section_from: int):
+    """Newton (:func:`_newton_batch`) for every run with a candidate lag k > 0, from its last
+    section state, the runs of one k at once. Returns {run: dict(converged, mu (largest
+    Floquet modulus), turns, reach (the last state's distance to the orbit), closing
+    (nearer at the end than half-way through the section), orbit)}."""
+    out = {}
     for k in np.unique(k_cand[k_cand > 0]):
         idx = np.flatnonzero(k_cand == k)
-        n = idx.size
-        x = runs.states[idx, -1].copy()
-        x[:, 2] = np.mod(x[:, 2], 2 * np.pi)     # the map commutes with whole turns of phi
         b, f = runs.angle_limit[idx], runs.force_limit[idx]
-        done = np.zeros(n, dtype=bool)
-        J = np.full((n, 6, 6), np.nan)
-        turns = np.zeros(n, dtype=int)
-        for _ in range(10):
-            act = np.flatnonzero(~done)
-            if act.size == 0:
-                break
-            starts = np.concatenate([x[act, None, :], x[act, None, :] + h * E[None]], axis=1).reshape(-1, 6)
-            Pk = switched_runs(body, gains, ref, np.repeat(b[act], 7), np.repeat(f[act], 7), s0=starts,
-                               n_periods=int(k), steps_per_period=steps_per_period).states[:, -1].reshape(-1, 7, 6)
-            turns[act] = np.rint((Pk[:, 0, 2] - x[act, 2]) / (2 * np.pi)).astype(int)
-            r = Pk[:, 0] - x[act]
-            r[:, 2] -= 2 * np.pi * turns[act]
-            J[act] = np.moveaxis((Pk[:, 1:] - Pk[:, :1]) / h, 1, 2)        # J[:, :, j] = d P^k / d x_j
-            conv = np.abs(r).max(axis=1) < o["newton_tol"]
-            done[act[conv]] = True
-            go = act[~conv]
-            if go.size:
-                step = np.linalg.solve(J[go] - np.eye(6)[None], -r[~conv, :, None])[..., 0]
-                step *= np.minimum(1.0, 0.1 / np.maximum(np.abs(step).max(axis=1), 1e-300))[:, None]
-                x[go] += step
-        mu = np.abs(np.linalg.eigvals(np.nan_to_num(J))).max(axis=1)
+        x, done, mu, turns = _newton_batch(body, gains, ref, b, f, runs.states[idx, -1], int(k), o, steps_per_period)
         # reach: the run's last section state against the orbit's k states (phi modulo 2 pi)
         orb = switched_runs(body, gains, ref, b, f, s0=x, n_periods=int(k), steps_per_period=steps_per_period)
+        mid = (runs.states.shape[1] + section_from) // 2
         for j, q in enumerate(idx):
-            d = runs.states[q, -1][None] - orb.states[j, :k]
-            d[:, 2] = wrap_angle(d[:, 2])
+            dist = []
+            for at in (mid, -1):
+                d = runs.states[q, at][None] - orb.states[j, :k]
+                d[:, 2] = wrap_angle(d[:, 2])
+                dist.append(float(np.abs(d).max(axis=1).min()))
             out[int(q)] = dict(converged=bool(done[j]), mu=float(mu[j]), turns=int(turns[j]),
-                               reach=float(np.abs(d).max(axis=1).min()), orbit=x[j].copy())
+                               reach=dist[1], closing=dist[1] < dist[0], orbit=x[j].copy())
     return out
+
+
+def _enclosed_orbits(body, gains, ref, runs: SwitchedRuns, idx, section_from: int, o, steps_per_period):
+    """For runs whose section looks like a closed curve: Newton for a period-1 orbit from
+    the curve's centre (the mean section state, phi by its circular mean). Returns
+    (converged, largest Floquet modulus) arrays for ``idx``."""
+    st = runs.states[idx, section_from:]
+    x0 = st.mean(axis=1)
+    x0[:, 2] = np.angle(np.exp(1j * st[:, :, 2]).mean(axis=1))
+    _, done, mu, _ = _newton_batch(body, gains, ref, runs.angle_limit[idx], runs.force_limit[idx], x0, 1, o,
+                                   steps_per_period)
+    return done, mu
 
 
 #: how many times longer :func:`extend_undecided` runs the points left undecided

@@ -290,7 +290,8 @@ def _check_chaos() -> Outcome:
     chaos = limit_verdicts(body, gains, ref, np.radians([30.0]))[0].iloc[0]
     qp = extend_undecided(body, gains, ref, limit_verdicts(body, gains, ref, np.radians([37.0]), 6.0)[0]).iloc[0]
     ok = (chaos.regime == "chaotic" and chaos.lyapunov > 6 * chaos.lyapunov_stderr and qp.regime == "quasiperiodic"
-          and abs(qp.lyapunov) * ref.period < 0.0075 and 3 * qp.lyapunov_stderr * ref.period < 0.0075)
+          and abs(qp.lyapunov) * ref.period < 0.0075 and 3 * qp.lyapunov_stderr * ref.period < 0.0075
+          and qp.floquet > 1.1)
     return Outcome(_status(ok, "reproduced"), chaos.lyapunov,
                    "largest Lyapunov exponent (1/s), angle limit 30 deg, eight",
                    "both occur: chaos at small and moderate angle limits without a cap; quasi-periodic motion "
