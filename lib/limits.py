@@ -248,8 +248,6 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
     S0 = np.broadcast_to(S0, (b.size, 6)) if S0.shape == (6,) or S0.shape == (1, 6) else S0
     if S0.shape != (b.size, 6) or not np.all(np.isfinite(S0)):
         raise ValueError(f"s0 must be a finite state (6,) or one per run ({b.size}, 6), got shape {S0.shape}")
-    if S0.shape[0] != b.size:
-        b, f = np.broadcast_to(b, S0.shape[0]).copy(), np.broadcast_to(f, S0.shape[0]).copy()
     g = gains
     P = np.array([body.m, body.I, body.a, body.c, body.c_phi, g.kp[0], g.kp[1], g.kv[0], g.kv[1], ref.R, ref.theta,
                   k_slide, 0.0 if isinstance(ref, Circle) else 1.0])
@@ -340,7 +338,8 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
     # a closed-looking section with a zero exponent: is there an orbit inside the curve, and
     # does it repel (the curve is an invariant torus) or attract (a slow spiral onto it)?
     ring = np.flatnonzero((k_cand == 0) & (np.abs(lamT) < band) & (3 * seT < band) & (returns < o["return_tol"]))
-    inner_conv, inner_mu = np.zeros(N, dtype=bool), np.full(N, np.nan)
+    is_ring, inner_conv, inner_mu = np.zeros(N, dtype=bool), np.zeros(N, dtype=bool), np.full(N, np.nan)
+    is_ring[ring] = True
     if ring.size:
         inner_conv[ring], inner_mu[ring] = _enclosed_orbits(body, gains, ref, runs, ring, ntr, o, steps_per_period)
     rows = []
@@ -354,10 +353,10 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
             regime = "slipping" if turns else "periodic"
         elif lamT[q] > max(3 * seT[q], band):
             regime = "chaotic"
-        elif q in ring and inner_conv[q] and inner_mu[q] < 1:
+        elif is_ring[q] and inner_conv[q] and inner_mu[q] < 1:
             mu = inner_mu[q]
             reason = f"slow spiral onto an attracting orbit inside the curve (|mu| = {inner_mu[q]:.4f})"
-        elif q in ring:
+        elif is_ring[q]:
             regime = "quasiperiodic"
             mu = inner_mu[q]      # the repelling orbit inside the torus, if found (NaN if not)
         elif ob is not None:

@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 from scipy.optimize import brentq
 
-from .allocation import Allocation, Limits
+from .allocation import Allocation, Limits, allocate
 from .angles import wrap_angle
 from .closed_loop import ClosedLoop, reference_of
 from .integrators.smooth import integrate
@@ -203,7 +203,7 @@ def force_cap_sweep(body: Body, gains: Gains, ref: Reference, caps, *, n_periods
         e = runs.errors[j, m]
         st = runs.states[j, m]
         tau = computed_torque(body, gains, ref, runs.t[m], st[:, :3], st[:, 3:])
-        F = np.minimum(np.hypot(tau[:, 0], tau[:, 1]), cap)
+        F, _ = allocate(tau, st[:, 2], force_limit=float(cap))      # (25)-(26) with the cap
         rows.append({"cap": float(cap), "pos_err_max": float(np.hypot(e[:, 0], e[:, 1]).max()),
                      "ex_amp": float(np.ptp(e[:, 0]) / 2), "ey_amp": float(np.ptp(e[:, 1]) / 2),
                      "sat_fraction": float(np.mean(F >= cap * (1 - 1e-9)))})

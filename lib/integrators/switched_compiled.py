@@ -52,7 +52,6 @@ _TWO_PI = 2.0 * math.pi
 #: (a jump of its derivative) alike. Kinks located to only 1e-8 s cost a factor 40 in the error
 #: of a chaotic run after two periods (measured: 2.5e-6 against 6e-8 at 20 deg, 400 steps)
 _T_TOL = 1e-11
-_T_TOL_KINK = 1e-11
 _MAX_EVENTS_PER_STEP = 200
 
 # layout of the parameter vector P
@@ -193,6 +192,15 @@ def _initial_mode(P, lim, t, s, g, tmp):
 
 
 @numba.njit(cache=True)
+def _copy(y, g, y_to, g_to):
+    """Copy a state (6,) and its event values into y_to, g_to."""
+    for q in range(6):
+        y_to[q] = y[q]
+    for k in range(N_EVENTS):
+        g_to[k] = g[k]
+
+
+@numba.njit(cache=True)
 def _hermite_root(P, lim, mode, t, dt, s, f0, y1, f1, g0, ev, yh, fh, gh):
     """Root in (0, dt) of event ``ev`` (as :func:`_fired` sees it from ``g0``) on the cubic
     Hermite interpolant of the step (t, s, f0) -> (t + dt, y1, f1), by bisection to 1e-10 dt:
@@ -237,20 +245,14 @@ def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2
             if first < 0:
                 if mode == 0:
                     stats[2] += dt
-                for q in range(6):
-                    s[q] = y1[q]
-                for k in range(N_EVENTS):
-                    g0[k] = g1[k]
+                _copy(y1, g1, s, g0)
                 t = t_end
                 break
             # bracket the first event in (lo, hi]
             lo, hi = 0.0, dt
             ev = first
             glo, ghi = g0[ev], g1[ev]
-            for q in range(6):
-                y2[q] = y1[q]
-            for k in range(N_EVENTS):
-                g2[k] = g1[k]
+            _copy(y1, g1, y2, g2)
             # first on the step's cubic Hermite interpolant (one field evaluation per try), then
             # two real steps a little before and after its root narrow the bracket cheaply
             guess = _hermite_root(P, lim, mode, t, dt, s, K[0], y1, ys, g0, ev, yh, fh, gh)
@@ -267,10 +269,7 @@ def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2
                             break
                     if hit >= 0:
                         hi = th
-                        for q in range(6):
-                            y2[q] = y1[q]
-                        for k in range(N_EVENTS):
-                            g2[k] = g1[k]
+                        _copy(y1, g1, y2, g2)
                         if hit != ev:
                             ev = hit
                             glo = g0[ev]
@@ -285,15 +284,14 @@ def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2
             it = 0
             stall = 0
             nudge = 0
-            tol = _T_TOL if (ev == 0 or mode == 0) else _T_TOL_KINK
-            while hi - lo > tol and it < 200:
+            while hi - lo > _T_TOL and it < 200:
                 it += 1
                 width = hi - lo
                 secant = False
                 if nudge == 1:
-                    th = lo + 0.9 * tol
+                    th = lo + 0.9 * _T_TOL
                 elif nudge == -1:
-                    th = hi - 0.9 * tol
+                    th = hi - 0.9 * _T_TOL
                 elif stall >= 2 or ghi == glo:
                     th = 0.5 * (lo + hi)
                     stall = 0
@@ -313,10 +311,7 @@ def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2
                             break
                 if hit >= 0:  # an event before th
                     hi = th
-                    for q in range(6):
-                        y2[q] = y1[q]
-                    for k in range(N_EVENTS):
-                        g2[k] = g1[k]
+                    _copy(y1, g1, y2, g2)
                     if hit != ev:  # another event comes first: follow it from here on
                         ev = hit
                         side = 0
@@ -334,7 +329,6 @@ def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2
                     side = -1
                     nudge = 1 if secant else 0
                 stall = stall + 1 if hi - lo > 0.5 * width else 0
-                tol = _T_TOL if (ev == 0 or mode == 0) else _T_TOL_KINK
             if mode == 0:
                 stats[2] += hi
             t += hi
