@@ -48,3 +48,25 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if "perturb" in getattr(item, "fixturenames", ()):
             item.add_marker(pytest.mark.robustness)
+
+
+# ------------------------------------------------------------------ checkout guard
+
+def pytest_sessionstart(session):
+    """Stop at once unless ``lib`` is this checkout's, both in this process and in a fresh
+    interpreter whose working directory holds no ``lib`` (as the book's notebook kernels,
+    which run in ``chapters/``): the editable install maps ``lib`` to an absolute path, so
+    a second checkout sharing the venv would otherwise test and build the first one's code
+    (``tests/test_packaging.py::test_lib_is_this_checkouts`` says the same as a test)."""
+    import tempfile
+
+    import lib
+
+    probe = subprocess.run([sys.executable, "-s", "-P", "-c",
+                            "import importlib.util; print(importlib.util.find_spec('lib').origin)"],
+                           cwd=tempfile.gettempdir(), capture_output=True, text=True)
+    for who, origin in (("this session", lib.__file__), ("a fresh interpreter", probe.stdout.strip() or None)):
+        if origin is None or not Path(origin).resolve().is_relative_to(ROOT):
+            pytest.exit(f"{who} imports lib from {origin}, not from this checkout {ROOT}: another checkout "
+                        f"shares the venv {sys.prefix}. Run `{sys.executable} -m pip install -e {ROOT}` "
+                        f"or give this checkout its own .venv.", returncode=pytest.ExitCode.USAGE_ERROR)
