@@ -44,6 +44,8 @@ def glue_all(values, prefix: str = "") -> None:
 def markdown_table(frame, index: bool = False):
     """Render a DataFrame as a Markdown table that MyST parses (so ``$...$`` math
     in cells is typeset); returns an :class:`IPython.display.Markdown` object.
+    Every cell and every column name is escaped: a ``|`` (as in ``$|\\mu_1|$``)
+    becomes ``\\|`` and a newline a space, so the table keeps its columns.
 
     Needs ``nb_render_markdown_format: myst`` (set in ``_config.yml``).
     """
@@ -51,11 +53,11 @@ def markdown_table(frame, index: bool = False):
 
     if index:
         frame = frame.reset_index()
-    cols = [str(c) for c in frame.columns]
 
     def cell(v) -> str:
         return str(v).replace("|", r"\|").replace("\n", " ")
 
+    cols = [cell(c) for c in frame.columns]
     lines = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
     lines += ["| " + " | ".join(cell(v) for v in row) + " |" for row in frame.itertuples(index=False)]
     return Markdown("\n".join(lines))
