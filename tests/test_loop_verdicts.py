@@ -4,7 +4,7 @@ closed loop, against Chapter 5's verdicts on the reduced rotation (32) and a lon
 import numpy as np
 import pytest
 
-from lib import trajectories as T, weighting
+from lib import loop_verdicts, trajectories as T, weighting
 from lib.allocation import Allocation, Limits
 from lib.closed_loop import ClosedLoop
 from lib.params import Body, Gains
@@ -86,7 +86,7 @@ def test_lean_field_is_the_closed_loop_of_eqs_23_and_2_4():
     for kind in ("eight", "circle"):
         R, Th, W = rng.uniform(0.3, 4, N), rng.uniform(-1.5, 1.5, N), rng.uniform(0.1, 2, (N, 3))
         W[:8, 2] = 0.0
-        flow = weighting._PeriodFlow(Body(), Gains(), np.full(N, kind), R, Th, W, "least_squares", Limits(), 64)
+        flow = loop_verdicts._PeriodFlow(Body(), Gains(), np.full(N, kind), R, Th, W, "least_squares", Limits(), 64)
         idx = np.arange(N)
         loop = ClosedLoop.of(Body(), Gains(), flow.kin(idx), Allocation("least_squares", W))
         for tau in (0.0, 1 / 128, 3 + 17 / 128, 7.5):
