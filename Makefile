@@ -8,6 +8,7 @@ STAMP := $(VENV)/.installed
 .PHONY: book test benchmark clean
 
 $(STAMP): requirements.txt pyproject.toml
+	@echo "Installing .venv from requirements.txt and pyproject.toml (a few minutes the first time)..."
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet -r requirements.txt
 	touch $(STAMP)
