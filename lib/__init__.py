@@ -4,4 +4,19 @@ flows one way, from the model core through the integrators to the analyses, the
 figures and, on top, the book's verdicts on the paper (``lib.paper``). The map of
 modules is ``lib/README.md``; ``tests/test_layout.py`` checks that the import graph
 is acyclic and flows this way.
+
+Where to start (import the modules you need; ``import lib`` itself loads nothing else):
+
+* ``lib.params.Body``, ``lib.params.Gains``: the body and the controller gains of the
+  paper's Table;
+* ``lib.trajectories.circle``, ``lib.trajectories.eight``: the references (27), (28);
+* ``lib.simulate.simulate``: the closed loop (2)-(4), (23), (25)-(26), with force and
+  angle limits (``lib.allocation.Limits``);
+* ``lib.tracking``: the runs and numbers of Figs. 2-4 (``run``, ``steady_summary``,
+  ``force_cap_sweep``);
+* ``lib.stability.eight_rotation_sweep``: the verdicts of Fig. 5 over (R, Theta) grids;
+* ``lib.limits.limit_verdicts``: the regime under an angle limit and a force cap;
+* ``lib.weighting.closed_loop_verdicts``: the same verdicts for the weighted allocation.
+
+README.md's "Where to start in the library" runs a small Fig. 5 map and a capped circle.
 """
