@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import html
 import numbers
+import re
 from collections.abc import Mapping
 from dataclasses import fields, is_dataclass
 
 import numpy as np
 
-__all__ = ["glue", "glue_all", "markdown_table"]
+__all__ = ["glue", "glue_all", "markdown_table", "with_alt"]
 
 
 def glue(name: str, value, display: bool = False) -> None:
@@ -61,3 +63,13 @@ def markdown_table(frame, index: bool = False):
     lines = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
     lines += ["| " + " | ".join(cell(v) for v in row) + " |" for row in frame.itertuples(index=False)]
     return Markdown("\n".join(lines))
+
+
+def with_alt(snippet: str, alt: str) -> str:
+    """``snippet`` (HTML, e.g. an animation from :func:`lib.animation.animate`) with ``alt``
+    as the alt text of every ``<img>`` that has none, so that a figure shown as HTML says
+    what it shows, as ``mystnb: image: alt:`` does for an image output."""
+    if not alt.strip():
+        raise ValueError("an alt text must say what the image shows")
+    attr = f' alt="{html.escape(alt.strip(), quote=True)}"'
+    return re.sub(r"<img\b(?![^>]*\balt=)", lambda m: m.group(0) + attr, snippet, flags=re.IGNORECASE)

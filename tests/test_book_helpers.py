@@ -51,3 +51,14 @@ def test_markdown_table_with_index_adds_the_index_as_first_column():
     header, rows = parse_table(markdown_table(frame, index=True).data)
     assert header == ["key", "v"]
     assert rows == [["k|1", "1.5"]]
+
+
+def test_with_alt_gives_every_image_without_one_the_alt_text():
+    from lib.book import with_alt
+
+    snippet = '<div><img id="a" src="x.png"><img alt="kept" src="y.png"><IMG\nsrc="z"></div>'
+    out = with_alt(snippet, 'The body "tracking" a circle.')
+    assert out.count('alt="The body &quot;tracking&quot; a circle."') == 2
+    assert 'alt="kept"' in out and out.count("alt=") == 3
+    with pytest.raises(ValueError):
+        with_alt(snippet, "  ")
