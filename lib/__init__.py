@@ -16,7 +16,8 @@ Where to start (import the modules you need; ``import lib`` itself loads nothing
   ``force_cap_sweep``);
 * ``lib.stability.eight_rotation_sweep``: the verdicts of Fig. 5 over (R, Theta) grids;
 * ``lib.limits.limit_verdicts``: the regime under an angle limit and a force cap;
-* ``lib.weighting.closed_loop_verdicts``: the same verdicts for the weighted allocation.
+* ``lib.weighting.closed_loop_verdicts``: the verdicts on the full closed loop, for any
+  allocation weights (Chapter 6).
 
 README.md's "Where to start in the library" runs a small Fig. 5 map and a capped circle.
 """

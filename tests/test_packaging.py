@@ -121,6 +121,13 @@ def test_lib_is_this_checkouts(tmp_path):
         f"shares the venv; run `{sys.executable} -m pip install -e {ROOT}` or give this checkout its own .venv")
 
 
+def test_import_lib_is_light(tmp_path):
+    """``import lib`` runs only its docstring: no numpy, no submodule (the entry points it
+    names are imported by who uses them)."""
+    code = "import sys, lib; print(sorted(m for m in sys.modules if m.split('.')[0] in ('lib', 'numpy')))"
+    assert _run(_FRESH + ["-c", code], cwd=ROOT).stdout.strip() == "['lib']"
+
+
 def test_citation_cff_cites_the_book_and_the_paper():
     cff = yaml.safe_load((ROOT / "CITATION.cff").read_text())
     assert cff["cff-version"] == "1.2.0"
