@@ -20,13 +20,13 @@ import numpy as np
 import pandas as pd
 
 from .angles import state_difference, wrap_angle
+from .dynamics import verdicts as dv
 from .dynamics.lyapunov import LyapunovEstimate, largest_lyapunov
 from .dynamics.sections import distinct_points, section_margin, section_period
 from .integrators.batch import dop853
 from .integrators.switched import Segments, SwitchedLoop
 from .parallel import map_in_processes
 from .params import PAPER_DZ0, PAPER_Z0, Body, Gains
-from .rotation_verdicts import section_returns
 from .trajectories import Circle, Eight, Reference
 
 __all__ = [
@@ -270,36 +270,59 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
                         slides=stats[:, 1].astype(int), t_sliding=stats[:, 2])
 
 
-#: regimes of :func:`limit_verdicts`, as Chapter 5 names them (:data:`lib.rotation_verdicts.REGIMES`)
+#: the options of :func:`limit_verdicts`; the thresholds mean what they mean in :mod:`lib.dynamics.verdicts`
 LIMIT_DEFAULTS = dict(transient=60, periods=120, block=12, max_period=8, candidate_tol=1e-3, newton_tol=1e-9,
                       fd_step=1e-6, reach_tol=1e-3, approach_tol=0.05, lyapunov_band=0.01, return_tol=0.05)
+
+#: Newton on the switched loop's period map: the Jacobian by differences, steps cut to 0.1
+_NEWTON = dict(max_iter=9, max_step=0.1)
+
+_STATUS = {"not converged": "Newton did not converge", "not attracting": "the orbit found is not attracting",
+           "not reached": "the run has not reached the orbit"}
+
+
+class _SwitchedMap:
+    """The switched loop's period map (a :class:`lib.dynamics.verdicts.PeriodMap`) over runs
+    with their own limits: the state (x, y, phi, and rates), the heading phi in column 2."""
+
+    turn_axis = 2
+
+    def __init__(self, body, gains, ref, b, f, steps_per_period):
+        self.body, self.gains, self.ref, self.b, self.f, self.steps = body, gains, ref, b, f, steps_per_period
+
+    def advance(self, idx, x, k):
+        k = np.unique(np.asarray(k, dtype=int))
+        if k.size != 1:
+            raise ValueError("the switched runs of one call share their number of periods")
+        return switched_runs(self.body, self.gains, self.ref, self.b[idx], self.f[idx], s0=x, n_periods=int(k[0]),
+                             steps_per_period=self.steps).states[:, -1]
+
+    def step(self, idx, x, k, h):
+        return dv.difference_jacobian(self, idx, x, k, h)
 
 
 def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force_limits=None, *, s0=None,
                    steps_per_period: int = STEPS_PER_PERIOD, **options):
     """Decide the long-run regime of the switched closed loop for each (angle limit (rad),
-    force limit (N)) pair, with the criteria of Chapter 5 (:func:`lib.rotation_verdicts.rotation_verdicts`)
+    force limit (N)) pair by the book's one decision procedure (:mod:`lib.dynamics.verdicts`)
     on the full state. Options (:data:`LIMIT_DEFAULTS`): ``transient`` periods dropped,
     then ``periods`` periods of section and of Lyapunov renormalisation.
 
     - **periodic** (or **slipping** if the heading advances by whole turns every k
-      periods): the section repeats at a lag k <= ``max_period`` to ``candidate_tol``;
-      Newton on P^k(x) = x + (0, 0, 2 pi n, 0, 0, 0), with the Jacobian by forward
-      differences (step ``fd_step``), converges to ``newton_tol``; the orbit attracts
-      (all Floquet multipliers, the eigenvalues of DP^k, inside the unit circle) and
-      the run has reached it: its last section state is within ``reach_tol`` of it, or
-      within ``approach_tol`` and nearer than half-way through the section (a slowly
-      attracting orbit, as Chapter 5 allows).
-    - **chaotic**: no such orbit and lambda T > max(3 SE T, ``lyapunov_band``), the
-      largest Lyapunov exponent lambda (1/s) with its standard error SE from the means
-      of blocks of ``block`` periods.
-    - **quasiperiodic**: no orbit, |lambda T| and 3 SE T below the band, the section
-      closes on itself (:func:`lib.rotation_verdicts.section_returns` below ``return_tol``),
-      and no *attracting* period-1 orbit lies inside the curve: Newton from the curve's
-      centre either finds none or finds one that repels (column floquet then holds its
-      largest |multiplier|, above 1, as where a torus is born from an orbit that lost
-      stability). An attracting one inside means a slow spiral onto it: undecided.
-    - **undecided** otherwise, with the reason.
+      periods): the section repeats at a lag k <= ``max_period`` to ``candidate_tol``
+      over its last 2 ``max_period`` states; Newton on P^k(x) = x + (0, 0, 2 pi n, 0, 0, 0),
+      with the Jacobian by forward differences (step ``fd_step``), converges to
+      ``newton_tol``; the orbit attracts (all Floquet multipliers, the eigenvalues of
+      DP^k, inside the unit circle) and the run has reached it
+      (:func:`lib.dynamics.verdicts.reached`: within ``reach_tol``, or within
+      ``approach_tol`` and closing in no slower than the slowest multiplier allows).
+    - **chaotic**, **quasiperiodic**, **undecided**: the rule
+      :func:`lib.dynamics.verdicts.classify` on the largest Lyapunov exponent lambda (1/s)
+      with its standard error SE from the means of blocks of ``block`` periods; a
+      quasi-periodic section must also enclose no *attracting* period-1 orbit
+      (:func:`lib.dynamics.verdicts.enclosed_orbit`; column floquet then holds the largest
+      |multiplier| of the orbit inside, above 1, where a torus is born from an orbit that
+      lost stability). An attracting one inside means a slow spiral onto it: undecided.
 
     Columns: angle_limit (rad), angle_deg, force_limit (N, inf for none), regime, period,
     turns (of the heading per period of a slipping orbit), floquet (largest |multiplier|),
@@ -318,135 +341,44 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
     runs = switched_runs(body, gains, ref, angle_limits, force_limits, s0=s0, n_periods=ntr + npr,
                          lyapunov_from=ntr, steps_per_period=steps_per_period)
     T, N = runs.period, runs.states.shape[0]
-    # the Lyapunov exponent and its batch-means standard error
-    nb = npr // blk
-    means = runs.log_growth[:, -nb * blk:].reshape(N, nb, blk).mean(axis=2) / T
-    lam = runs.log_growth.mean(axis=1) / T
-    se = means.std(axis=1, ddof=1) / np.sqrt(nb)
-    # candidates: the smallest lag at which the last section states repeat (p modulo 2 pi)
+    pmap = _SwitchedMap(body, gains, ref, runs.angle_limit, runs.force_limit, steps_per_period)
+    step = lambda i, x, k: pmap.step(i, x, k, o["fd_step"])  # noqa: E731
+    lamT, seT = dv.block_statistics(runs.log_growth, blk)
+    hist = np.moveaxis(runs.states[:, ntr:], 0, 1).copy()
+    hist[..., 2] = np.mod(hist[..., 2], 2 * np.pi)     # the map commutes with whole turns of phi
+    idx = np.arange(N)
+    orb = dv.find_orbits(step, pmap, idx, hist, max_period=kmax, candidate_tol=o["candidate_tol"],
+                         newton_tol=o["newton_tol"], reach_tol=o["approach_tol"], reach_floor=o["reach_tol"],
+                         newton_options=_NEWTON, fixed_turns=False, ends=2 * kmax)
     sec = runs.errors[:, ntr:]
-    k_cand = np.zeros(N, dtype=int)
-    for k in range(kmax, 0, -1):
-        d = sec[:, -2 * kmax:] - sec[:, -2 * kmax - k:-k]
-        d[..., 4] = wrap_angle(d[..., 4])
-        close = np.abs(d).max(axis=(1, 2)) < o["candidate_tol"]
-        k_cand[close] = k
-    orbit = _locate_orbits(body, gains, ref, runs, k_cand, o, steps_per_period, ntr)
-    returns = section_returns(np.moveaxis(sec, 0, 1), angles=(4,))
-    band = o["lyapunov_band"]
-    lamT, seT = lam * T, se * T
-    # a closed-looking section with a zero exponent: is there an orbit inside the curve, and
-    # does it repel (the curve is an invariant torus) or attract (a slow spiral onto it)?
-    ring = np.flatnonzero((k_cand == 0) & (np.abs(lamT) < band) & (3 * seT < band) & (returns < o["return_tol"]))
-    is_ring, inner_conv, inner_mu = np.zeros(N, dtype=bool), np.zeros(N, dtype=bool), np.full(N, np.nan)
-    is_ring[ring] = True
+    returns = dv.section_returns(np.moveaxis(sec, 0, 1), angles=(4,))
+    regime, reason = dv.classify(lamT, seT, returns, band=o["lyapunov_band"], return_tol=o["return_tol"],
+                                 max_period=kmax)
+    mu = np.where(orb["status"] != "", orb["floquet"], np.nan)
+    ring = np.flatnonzero(~orb["found"] & (regime == "quasiperiodic"))
     if ring.size:
-        inner_conv[ring], inner_mu[ring] = _enclosed_orbits(body, gains, ref, runs, ring, ntr, o, steps_per_period)
+        att, mu[ring] = dv.enclosed_orbit(step, ring, hist[:, ring], turn_axis=2, newton_tol=o["newton_tol"],
+                                          newton_options=_NEWTON)
+        spiral = ring[att]
+        regime[spiral] = "undecided"
+        reason[spiral] = [f"slow spiral onto an attracting orbit inside the curve (|mu| = {m:.4f})" for m in mu[spiral]]
+    tried = ~orb["found"] & (orb["status"] != "") & (regime == "undecided")
+    reason[tried] = [f"{_STATUS[s]}; {r}" for s, r in zip(orb["status"][tried], reason[tried])]
+    found = orb["found"]
+    regime[found] = dv.orbit_regime(orb["n"][found])
+    reason[found] = ""
     rows = []
     for q in range(N):
-        k, ob = int(k_cand[q]), orbit.get(q)
-        regime, reason, period, turns, mu, x = "undecided", "", 0, 0, np.nan, None
-        reached = ob is not None and (ob["reach"] < o["reach_tol"] or (ob["reach"] < o["approach_tol"]
-                                                                        and ob["closing"]))
-        if ob is not None and ob["converged"] and ob["mu"] < 1 and reached:
-            period, turns, mu, x = k, ob["turns"], ob["mu"], ob["orbit"]
-            regime = "slipping" if turns else "periodic"
-        elif lamT[q] > max(3 * seT[q], band):
-            regime = "chaotic"
-        elif is_ring[q] and inner_conv[q] and inner_mu[q] < 1:
-            mu = inner_mu[q]
-            reason = f"slow spiral onto an attracting orbit inside the curve (|mu| = {inner_mu[q]:.4f})"
-        elif is_ring[q]:
-            regime = "quasiperiodic"
-            mu = inner_mu[q]      # the repelling orbit inside the torus, if found (NaN if not)
-        elif ob is not None:
-            mu = ob["mu"]
-            reason = ("Newton did not converge" if not ob["converged"] else
-                      f"orbit of period {k} not attracting" if ob["mu"] >= 1 else "orbit not reached")
-        elif abs(lamT[q]) < band and 3 * seT[q] < band:
-            reason = "zero exponent, section does not close"
-        else:
-            reason = "exponent not resolved from zero"
         p = sec[q, :, 4]
         rows.append(dict(angle_limit=runs.angle_limit[q], angle_deg=float(np.degrees(runs.angle_limit[q])),
-                         force_limit=runs.force_limit[q], regime=regime, period=period, turns=turns,
-                         floquet=mu, lyapunov=lam[q], lyapunov_stderr=se[q], returns=returns[q],
-                         p_range=float(np.ptp(p)), pos_err=float(np.hypot(sec[q, :, 0], sec[q, :, 1]).max()),
+                         force_limit=runs.force_limit[q], regime=regime[q], period=int(orb["k"][q]),
+                         turns=int(orb["n"][q]), floquet=mu[q], lyapunov=lamT[q] / T, lyapunov_stderr=seT[q] / T,
+                         returns=returns[q], p_range=float(np.ptp(p)),
+                         pos_err=float(np.hypot(sec[q, :, 0], sec[q, :, 1]).max()),
                          crossings=int(runs.crossings[q]), slides=int(runs.slides[q]),
-                         t_sliding=float(runs.t_sliding[q]), reason=reason, orbit=x))
+                         t_sliding=float(runs.t_sliding[q]), reason=reason[q],
+                         orbit=orb["x"][q].copy() if found[q] else None))
     return pd.DataFrame(rows), runs
-
-
-def _newton_batch(body, gains, ref, b, f, x0, k: int, o, steps_per_period):
-    """Newton on P^k(x) = x + (0, 0, 2 pi n, 0, 0, 0) for runs with limits b, f (arrays) from
-    the states x0 (n, 6), all at once and only those not yet converged: the Jacobian by
-    forward differences (6 extra runs per run and iteration). (Each run has its own limits,
-    so :func:`lib.dynamics.orbits.newton_orbit`, which maps the points alone, does not fit.)
-    Returns (x, converged, largest Floquet modulus, turns n)."""
-    h = o["fd_step"]
-    E = np.eye(6)
-    x = np.array(x0, dtype=float)
-    x[:, 2] = np.mod(x[:, 2], 2 * np.pi)     # the map commutes with whole turns of phi
-    n = x.shape[0]
-    done = np.zeros(n, dtype=bool)
-    J = np.full((n, 6, 6), np.nan)
-    turns = np.zeros(n, dtype=int)
-    for _ in range(10):
-        act = np.flatnonzero(~done)
-        if act.size == 0:
-            break
-        starts = np.concatenate([x[act, None, :], x[act, None, :] + h * E[None]], axis=1).reshape(-1, 6)
-        Pk = switched_runs(body, gains, ref, np.repeat(b[act], 7), np.repeat(f[act], 7), s0=starts,
-                           n_periods=int(k), steps_per_period=steps_per_period).states[:, -1].reshape(-1, 7, 6)
-        turns[act] = np.rint((Pk[:, 0, 2] - x[act, 2]) / (2 * np.pi)).astype(int)
-        r = Pk[:, 0] - x[act]
-        r[:, 2] -= 2 * np.pi * turns[act]
-        J[act] = np.moveaxis((Pk[:, 1:] - Pk[:, :1]) / h, 1, 2)        # J[:, :, j] = d P^k / d x_j
-        conv = np.abs(r).max(axis=1) < o["newton_tol"]
-        done[act[conv]] = True
-        go = act[~conv]
-        if go.size:
-            step = np.linalg.solve(J[go] - np.eye(6)[None], -r[~conv, :, None])[..., 0]
-            step *= np.minimum(1.0, 0.1 / np.maximum(np.abs(step).max(axis=1), 1e-300))[:, None]
-            x[go] += step
-    mu = np.abs(np.linalg.eigvals(np.nan_to_num(J))).max(axis=1)
-    return x, done, mu, turns
-
-
-def _locate_orbits(body, gains, ref, runs: SwitchedRuns, k_cand, o, steps_per_period, section_from: int):
-    """Newton (:func:`_newton_batch`) for every run with a candidate lag k > 0, from its last
-    section state, the runs of one k at once. Returns {run: dict(converged, mu (largest
-    Floquet modulus), turns, reach (the last state's distance to the orbit), closing
-    (nearer at the end than half-way through the section), orbit)}."""
-    out = {}
-    for k in np.unique(k_cand[k_cand > 0]):
-        idx = np.flatnonzero(k_cand == k)
-        b, f = runs.angle_limit[idx], runs.force_limit[idx]
-        x, done, mu, turns = _newton_batch(body, gains, ref, b, f, runs.states[idx, -1], int(k), o, steps_per_period)
-        # reach: the run's last section state against the orbit's k states (phi modulo 2 pi)
-        orb = switched_runs(body, gains, ref, b, f, s0=x, n_periods=int(k), steps_per_period=steps_per_period)
-        mid = (runs.states.shape[1] + section_from) // 2
-        for j, q in enumerate(idx):
-            dist = []
-            for at in (mid, -1):
-                d = runs.states[q, at][None] - orb.states[j, :k]
-                d[:, 2] = wrap_angle(d[:, 2])
-                dist.append(float(np.abs(d).max(axis=1).min()))
-            out[int(q)] = dict(converged=bool(done[j]), mu=float(mu[j]), turns=int(turns[j]),
-                               reach=dist[1], closing=dist[1] < dist[0], orbit=x[j].copy())
-    return out
-
-
-def _enclosed_orbits(body, gains, ref, runs: SwitchedRuns, idx, section_from: int, o, steps_per_period):
-    """For runs whose section looks like a closed curve: Newton for a period-1 orbit from
-    the curve's centre (the mean section state, phi by its circular mean). Returns
-    (converged, largest Floquet modulus) arrays for ``idx``."""
-    st = runs.states[idx, section_from:]
-    x0 = st.mean(axis=1)
-    x0[:, 2] = np.angle(np.exp(1j * st[:, :, 2]).mean(axis=1))
-    _, done, mu, _ = _newton_batch(body, gains, ref, runs.angle_limit[idx], runs.force_limit[idx], x0, 1, o,
-                                   steps_per_period)
-    return done, mu
 
 
 #: how many times longer :func:`extend_undecided` runs the points left undecided

@@ -7,7 +7,8 @@ names Chapter 5 and other code use, gathered from where each is defined.
 * :mod:`lib.rotation`: the reduced rotation for many (R, Theta) at once, the Fig. 5 sweep,
   periodic orbits and Lyapunov exponents;
 * :mod:`lib.rotation_verdicts`: the decisive verdicts of Fig. 5 (orbits, Floquet multipliers,
-  Lyapunov exponents, drift) and the attracting orbits of one point;
+  Lyapunov exponents, drift), by the one decision procedure of :mod:`lib.dynamics.verdicts`;
+* :mod:`lib.rotation_attractor`: the attracting orbits of one point, and a map's summary;
 * :mod:`lib.trajectories`: the Fourier series of the eight's tangent angle.
 """
 
@@ -15,8 +16,8 @@ from .circle_rotation import (circle_critical_radius, circle_eigenvalues, circle
                               circle_jacobian, circle_rotation_rhs, circle_slipping_coexists)
 from .rotation import (ENGINES, classify_samples, reduced_rotation, rotation_sweep, sampled_range,
                        steps_per_period)
-from .rotation_verdicts import (REGIMES, MapSummary, RotationAttractor, eight_rotation_sweep, map_summary,
-                               rotation_attractor, rotation_verdicts)
+from .rotation_attractor import MapSummary, RotationAttractor, map_summary, rotation_attractor
+from .rotation_verdicts import REGIMES, eight_rotation_sweep, rotation_verdicts
 from .rotation_equations import (RotationEquation, corrected_p0, derive_eight_equation, derive_rotation_equation,
                                  printed_eq33, printed_eq37, printed_p0)
 from .trajectories import PAPER_HEADING_SERIES, eight_heading_fourier, heading_series

@@ -11,7 +11,7 @@ LIB = Path(__file__).resolve().parents[1] / "lib"
 
 #: function-local imports of lib modules, each with the cost that justifies it
 LOCAL_IMPORTS_ALLOWED = {("lib.rotation", "lib.integrators.compiled"),               # numba's import and compile
-                         ("lib.rotation_verdicts", "lib.integrators.compiled"),
+                         ("lib.rotation_engine", "lib.integrators.compiled"),
                          ("lib.limits", "lib.integrators.switched_compiled")}
 
 

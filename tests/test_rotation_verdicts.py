@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from lib import rotation, rotation_verdicts as verdicts, simulate, trajectories
+from lib import rotation, rotation_attractor as attractor, rotation_verdicts as verdicts, simulate, trajectories
 from lib.integrators import batch, compiled
 from lib.params import Body, Gains
 
@@ -64,7 +64,7 @@ def test_paper_eight_is_period_one_and_its_orbit_is_an_orbit_of_the_full_closed_
     assert row.regime == "periodic" and row.period == 1 and not row.lost
     assert 0.92 < row.floquet < 0.945 and row.residual <= 1e-10
     # the orbit itself: started on it, the full closed loop (solve_ivp) comes back after one period
-    orb = verdicts.rotation_attractor(BODY, "eight", *EIGHT, p0=p0)
+    orb = attractor.rotation_attractor(BODY, "eight", *EIGHT, p0=p0)
     assert abs(orb.multipliers[0]) == pytest.approx(row.floquet, rel=1e-9) and abs(orb.multipliers[1]) < 0.01
     t, p, dp = _full_loop_period(*EIGHT, *orb.states[0])
     assert abs(p[-1] - p[0]) < 1e-7
@@ -79,9 +79,9 @@ def test_paper_eight_is_period_one_and_its_orbit_is_an_orbit_of_the_full_closed_
 
 
 def test_the_eight_has_two_mirror_image_orbits_and_each_start_reaches_its_own():
-    a = verdicts.rotation_attractor(BODY, "eight", *EIGHT, p0=0.0)
-    b = verdicts.rotation_attractor(BODY, "eight", *EIGHT, p0=1.0)
-    c = verdicts.rotation_attractor(BODY, "eight", *EIGHT, p0=-1.0)
+    a = attractor.rotation_attractor(BODY, "eight", *EIGHT, p0=0.0)
+    b = attractor.rotation_attractor(BODY, "eight", *EIGHT, p0=1.0)
+    c = attractor.rotation_attractor(BODY, "eight", *EIGHT, p0=-1.0)
     assert abs(a.states[0, 0] - b.states[0, 0]) > 0.1                  # two different orbits
     np.testing.assert_allclose(b.states, c.states, atol=1e-9)           # +-1 reach the same one
     np.testing.assert_allclose(np.abs(a.multipliers), np.abs(b.multipliers), rtol=1e-8)
@@ -109,7 +109,7 @@ def test_period_three_orbit_is_found_and_is_an_orbit(perturb):
     R, Th = 0.553030, 0.372222
     row = verdicts.eight_rotation_sweep(BODY, [R], [Th], p0=p0).iloc[0]
     assert row.regime == "periodic" and row.period == 3 and row.floquet < 0.5
-    orb = verdicts.rotation_attractor(BODY, "eight", R, Th, p0=p0)
+    orb = attractor.rotation_attractor(BODY, "eight", R, Th, p0=p0)
     step = rotation.rotation_period_map(BODY, "eight", [R], [Th], steps=int(row.steps))
     x0 = np.array([[orb.states[0, 0] + rotation._shape("eight")[0](0.0)[4],
                     orb.states[0, 1] / Th + rotation._shape("eight")[0](0.0)[5]]])
@@ -130,7 +130,7 @@ def test_chaotic_point_has_a_positive_lyapunov_exponent_like_the_numpy_reference
                                      steps=int(row.steps), p0=p0)
     assert abs(row.lyapunov - ref.value[0]) < 4 * math.hypot(row.lyapunov_stderr, 2 * ref.stderr[0])
     with pytest.raises(ValueError, match="no attracting orbit"):
-        verdicts.rotation_attractor(BODY, "eight", *CHAOTIC, p0=p0)
+        attractor.rotation_attractor(BODY, "eight", *CHAOTIC, p0=p0)
 
 
 def test_sweep_columns_and_the_lost_definition(perturb):
@@ -182,9 +182,9 @@ def test_bad_kind_and_bad_attractor_input():
     with pytest.raises(TypeError, match="body"):
         verdicts.rotation_verdicts(None, "eight", [1.0], [0.5])
     with pytest.raises(TypeError, match="R"):
-        verdicts.rotation_attractor(BODY, "eight", [2.0], 0.5)
+        attractor.rotation_attractor(BODY, "eight", [2.0], 0.5)
     with pytest.raises(ValueError, match="Theta"):
-        verdicts.rotation_attractor(BODY, "eight", 2.0, -0.5)
+        attractor.rotation_attractor(BODY, "eight", 2.0, -0.5)
 
 
 def test_fused_rates_of_the_compiled_variational_equation_are_the_two_definitions_bit_for_bit():
@@ -212,7 +212,7 @@ def test_orbits_are_measured_on_the_fine_map_whatever_the_verdict_map():
 
 
 def test_distance_to_an_orbit_is_zero_on_it_and_the_offset_off_it():
-    orb = verdicts.rotation_attractor(BODY, "eight", *EIGHT)
+    orb = attractor.rotation_attractor(BODY, "eight", *EIGHT)
     T = float(orb.t[-1])
     t = np.concatenate([orb.t[:-1] + j * T for j in range(3)])
     p = np.tile(orb.p[:-1], 3) + 2 * np.pi      # a whole turn away is the same heading
@@ -232,7 +232,7 @@ def test_map_summary_counts_what_the_frame_holds():
         "floquet": [0.95, 0.2, 0.5, np.nan, np.nan, np.nan],
         "lyapunov": [-0.01, -0.3, -0.1, 0.2, 0.4, 0.0], "lyapunov_stderr": [0, 0, 0, 0.02, 0.1, 0.1],
         "lost": [False, False, True, True, False, False], "periods": [8, 16, 24, 120, 120, 348]})
-    s = verdicts.map_summary(frame)
+    s = attractor.map_summary(frame)
     assert (s.n_grid, s.n_periodic, s.n_slipping, s.n_chaotic, s.n_quasiperiodic, s.n_undecided) == (6, 2, 1, 2, 0, 1)
     assert (s.n_lost, s.n_lost_slipping, s.n_lost_no_orbit, s.n_chaotic_within_turn) == (2, 1, 1, 1)
     assert s.chaotic_range_median == 3.5
@@ -240,7 +240,7 @@ def test_map_summary_counts_what_the_frame_holds():
     assert (s.range_min, s.range_max, s.theta_min_lost, s.theta_min_chaotic) == (0.5, 2.0, 0.3, 0.4)
     assert (s.lyapunov_min, s.lyapunov_max, s.lyapunov_sigmas_min, s.floquet_max) == (0.2, 0.4, 4.0, 0.95)
     with pytest.raises(ValueError, match="columns"):
-        verdicts.map_summary(frame.drop(columns="lost"))
+        attractor.map_summary(frame.drop(columns="lost"))
 
 
 def test_section_returns_tells_a_closed_curve_from_a_slow_approach():
@@ -293,10 +293,10 @@ def test_mirror_distance_separates_symmetric_orbits_from_mirror_pairs():
     df = verdicts.eight_rotation_sweep(BODY, [EIGHT[0], 2.0], [EIGHT[1], 0.1])
     assert list(df.regime) == ["periodic", "periodic"]
     assert df.mirror[0] > 0.1 and df.mirror[1] < 1e-9
-    a = verdicts.rotation_attractor(BODY, "eight", *EIGHT, p0=0.0)
-    b = verdicts.rotation_attractor(BODY, "eight", *EIGHT, p0=1.0)
+    a = attractor.rotation_attractor(BODY, "eight", *EIGHT, p0=0.0)
+    b = attractor.rotation_attractor(BODY, "eight", *EIGHT, p0=1.0)
     # the mirror distance at s = 0 is the distance from one orbit's point to the other's
     assert abs(a.states[0, 0] - b.states[0, 0]) <= df.mirror[0] + 1e-9
-    assert verdicts.map_summary(df).n_asymmetric == 1
+    assert attractor.map_summary(df).n_asymmetric == 1
     circle = verdicts.rotation_verdicts(BODY, "circle", [2.0], [math.pi / 4])
     assert circle.regime[0] == "periodic" and np.isnan(circle.mirror[0])

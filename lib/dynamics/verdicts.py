@@ -47,8 +47,8 @@ from ..angles import wrap_angle
 from .orbits import floquet_multipliers
 
 __all__ = ["REGIMES", "SIGMAS", "PeriodMap", "lag_candidates", "difference_jacobian", "newton", "least_period",
-           "distance_to_orbit", "reached", "block_statistics", "drift_statistics", "section_returns", "classify",
-           "heading_lost", "orbit_regime", "orbit_points", "find_orbits"]
+           "distance_to_orbit", "reached", "block_statistics", "batch_means", "drift_statistics", "section_returns", "classify",
+           "heading_lost", "orbit_regime", "orbit_points", "find_orbits", "enclosed_orbit"]
 
 #: the verdicts, in the order the book lists them
 REGIMES = ("periodic", "slipping", "chaotic", "quasiperiodic", "undecided")
@@ -212,8 +212,13 @@ def block_statistics(per_period, block: int) -> tuple[np.ndarray, np.ndarray]:
     nb = L // block
     if nb < 2:
         raise ValueError(f"need at least two blocks of {block} periods, got {L} periods")
-    means = v[:, L - nb * block:].reshape(N, nb, block).mean(axis=2)
-    return means.mean(axis=1), means.std(axis=1, ddof=1) / np.sqrt(nb)
+    return batch_means(v[:, L - nb * block:].reshape(N, nb, block).mean(axis=2))
+
+
+def batch_means(block_means) -> tuple[np.ndarray, np.ndarray]:
+    """Mean and standard error of the means of consecutive blocks (N, nb), nb >= 2."""
+    m = np.asarray(block_means, dtype=float)
+    return m.mean(axis=1), m.std(axis=1, ddof=1) / np.sqrt(m.shape[1])
 
 
 def drift_statistics(at_block_ends, periods_per_block: float, unit: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
@@ -377,3 +382,21 @@ def heading_lost(orbit, turns, drift, drift_se, p_range, *, slip_band: float) ->
     orbit = np.asarray(orbit, dtype=bool)
     drifting = np.abs(drift) > SIGMAS * np.asarray(drift_se) + slip_band
     return np.where(orbit, np.asarray(turns) != 0, drifting | (np.asarray(p_range) > TWO_PI))
+
+
+def enclosed_orbit(step: Callable, idx, sec, *, turn_axis: int, newton_tol: float, newton_options: dict):
+    """Is there an attracting period-1 orbit inside a closed section curve? Newton from the
+    curve's centre: the mean of the section states ``sec`` (L, M, d) of the rows ``idx``,
+    the heading by its circular mean. A zero exponent and a closed section mean a torus
+    only if the orbit inside repels (or none is found); an attracting one inside means a
+    slow spiral onto it. Returns (attracting (M,) bool, largest |multiplier| (M,), NaN
+    where Newton did not converge)."""
+    sec = np.asarray(sec, dtype=float)
+    x0 = sec.mean(axis=0)
+    x0[:, turn_axis] = np.angle(np.exp(1j * sec[:, :, turn_axis]).mean(axis=0))
+    _, J, res, _ = newton(step, idx, x0, 1, turn_axis=turn_axis, tol=newton_tol, **newton_options)
+    ok = res <= newton_tol
+    mu = np.full(ok.size, np.nan)
+    if ok.any():
+        mu[ok] = np.abs(floquet_multipliers(J[ok])[:, 0])
+    return ok & (mu < 1.0), mu

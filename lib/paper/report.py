@@ -32,7 +32,8 @@ from ..controllability import free_lie_rank, paper_bracket_count
 from ..limits import extend_undecided, limit_verdicts
 from ..model import f, generalized_force
 from ..params import Body, Gains
-from ..rotation_verdicts import eight_rotation_sweep, map_summary, rotation_attractor
+from ..rotation_attractor import map_summary, rotation_attractor
+from ..rotation_verdicts import eight_rotation_sweep
 from ..rotation_equations import derive_rotation_equation
 from ..simulate import Integration, open_loop_comparison, simulate
 from ..symbolic import derive_body_frame, rank_determinants
