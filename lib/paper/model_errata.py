@@ -13,54 +13,74 @@ from ..controllability import (free_lie_rank, paper_bracket_count, rest_report, 
 from ..symbolic import (Bracket, _slug, _symbols_only, accessibility_matrix, bracket_latex, compare_printed_brackets,
                         derive_body_frame, evaluate_bracket, lie_bracket, model_fields, printed_brackets,
                         printed_drift, rank_determinants)
+from ..params import Body
 from .verdicts import Erratum, Verdict
 
 __all__ = ["ROWS"]
 
 
-def _check_drift_row() -> Verdict:
+def _check_drift_row(printed=None, corrected=None) -> Verdict:
+    """The drift (6): ``printed`` the drift as printed (a 6-vector; default
+    :func:`lib.symbolic.printed_drift`), ``corrected`` its fifth row as corrected
+    (default -c/m v2 - v1 omega); each holds if it equals the derivation."""
     model = derive_body_frame()
     X, Y, PHI, V1, V2, W = model.q
     p = model.params
-    diff = sp.simplify(printed_drift(model) - model.f)
+    printed = printed_drift(model) if printed is None else sp.Matrix(printed)
+    corrected = -p["c"] / p["m"] * V2 - V1 * W if corrected is None else corrected
+    diff = sp.simplify(printed - model.f)
     wrong_rows = [i + 1 for i in range(6) if diff[i] != 0]
-    corrected_row = -p["c"] / p["m"] * V2 - V1 * W
     return Verdict(
         printed_holds=not wrong_rows,
-        corrected_holds=sp.simplify(model.f[4] - corrected_row) == 0,
+        corrected_holds=sp.simplify(model.f[4] - corrected) == 0,
         detail=f"printed minus derived drift is nonzero in row(s) {wrong_rows}: {sp.sstr(diff[4])}",
     )
 
 
-def _entry_check(expr: Bracket, row: int, corrected) -> Callable[[], Verdict]:
-    def check():
+def _entry_check(expr: Bracket, row: int, corrected_entry) -> Callable[..., Verdict]:
+    def check(printed=None, corrected=None):
+        """Entry ``row`` of bracket ``expr`` under (21): ``printed`` the entry as printed
+        (default from :func:`lib.symbolic.printed_brackets`), ``corrected`` as corrected
+        (default the row's typed value); each holds if it equals the derived entry."""
         model = derive_body_frame()
         rec = next(r for r in compare_printed_brackets(model) if r["bracket"] == expr and r["row"] == row)
-        fixed = corrected(model)
+        printed = rec["printed"] if printed is None else printed
+        fixed = corrected_entry(model) if corrected is None else corrected
         why = {"drift typo": "follows from the sign typo of (6): the printed drift gives exactly the printed entry",
                "independent": f"independent of (6): the printed drift gives {sp.sstr(rec['printed_drift'])}",
                "correct": "entry is correct"}[rec["verdict"]]
         if rec["opposite_convention"]:
             why += " (the sign of the opposite convention [g, f])"
         return Verdict(
-            printed_holds=rec["verdict"] == "correct",
+            printed_holds=sp.simplify(printed - rec["derived"]) == 0,
             corrected_holds=sp.simplify(fixed - rec["derived"]) == 0,
             detail=f"derived {sp.sstr(rec['derived'])}; {why}",
         )
     return check
 
 
-def _check_count() -> Verdict:
+def _witt_count(w: int, r: int) -> int:
+    """Independent r-th order brackets of the drift and w inputs: Witt's formula."""
+    return witt_dimension(w + 1, r + 1)
+
+
+def _check_count(printed=None, corrected=None) -> Verdict:
+    """The number of r-th order brackets of the drift and w inputs (w <= 2, r <= 3):
+    ``printed`` and ``corrected`` are functions (w, r) -> count of independent brackets
+    (defaults :func:`lib.controllability.paper_bracket_count`, Witt's formula), each
+    holding if it gives the rank of the brackets in the free algebra; the corrected row
+    also keeps w(w+1)^r/2 as the number of bracket expressions."""
+    printed = paper_bracket_count if printed is None else printed
+    corrected = _witt_count if corrected is None else corrected
     cases = [(w, r) for w in (1, 2) for r in (1, 2, 3)]
     names = lambda w: ["f"] + [f"g{i + 1}" for i in range(w)]  # noqa: E731
     indep = {(w, r): free_lie_rank(names(w), r) for w, r in cases}
-    wrong = [(w, r, paper_bracket_count(w, r), indep[w, r]) for w, r in cases
-             if paper_bracket_count(w, r) != indep[w, r]]
+    wrong = [(w, r, printed(w, r), indep[w, r]) for w, r in cases if printed(w, r) != indep[w, r]]
     exprs_ok = all(len(right_nested(names(w), r)) == paper_bracket_count(w, r) for w, r in cases)
-    witt_ok = all(indep[w, r] == witt_dimension(w + 1, r + 1) for w, r in cases)
+    indep_ok = all(indep[w, r] == corrected(w, r) for w, r in cases)
     return Verdict(
         printed_holds=not wrong,
-        corrected_holds=exprs_ok and witt_ok,
+        corrected_holds=exprs_ok and indep_ok,
         detail="(w, r, printed, independent): " + ", ".join(map(str, wrong)),
     )
 
@@ -71,61 +91,120 @@ def _counterexample():
     return [x1, x2], {"f": sp.Matrix([0, x1**2]), "g": sp.Matrix([1, 0])}
 
 
-def _check_theorem6() -> Verdict:
+#: the brackets that show the counterexample accessible at 0
+_COUNTER_BRACKETS = ["g", ("f", "g"), ("g", ("f", "g"))]
+
+
+def _theorem6_printed(fields, q, at) -> bool:
+    """Theorem 6 as printed: STLC at ``at`` if locally accessible there."""
+    return accessibility_matrix(fields, _COUNTER_BRACKETS, q).subs(at).rank() == len(q)
+
+
+def _theorem6_corrected(fields, q, at) -> bool:
+    """Theorem 6 corrected (Sussmann 1987, Thm. 7.3): STLC at the equilibrium ``at`` if
+    accessible there and every bad bracket is neutralised by good ones of lower degree."""
+    return _theorem6_printed(fields, q, at) and sussmann_check(fields, q, at, drift="f",
+                                                               max_order=2).all_bad_neutralised
+
+
+def _check_theorem6(printed=None, corrected=None) -> Verdict:
+    """``printed`` and ``corrected`` are theorems: functions (fields, q, point) -> whether
+    they conclude STLC at the point (defaults :func:`_theorem6_printed`,
+    :func:`_theorem6_corrected`). A theorem fails if it concludes STLC for the
+    counterexample x1' = u, x2' = x1^2 at 0, which is not STLC."""
+    printed = _theorem6_printed if printed is None else printed
+    corrected = _theorem6_corrected if corrected is None else corrected
     q, fields = _counterexample()
     at0 = {q[0]: 0, q[1]: 0}
-    C = accessibility_matrix(fields, ["g", ("f", "g"), ("g", ("f", "g"))], q).subs(at0)
-    accessible = C.rank() == 2
+    C = accessibility_matrix(fields, _COUNTER_BRACKETS, q).subs(at0)
     # x2' = x1^2 + 0*u >= 0 for every state and input: x2 never decreases, so
     # (0, -eps) is never reached and 0 is not interior to the reachable set
     rate = fields["f"][1] + fields["g"][1] * sp.Symbol("u", real=True)
-    monotone = bool(rate.is_nonnegative)
+    not_stlc = bool(rate.is_nonnegative)
     counter = sussmann_check(fields, q, at0, drift="f", max_order=2)
     return Verdict(
-        printed_holds=not (accessible and monotone),
-        corrected_holds=(not counter.all_bad_neutralised) and rest_report().complete,
+        printed_holds=not (printed(fields, q, at0) and not_stlc),
+        corrected_holds=not (corrected(fields, q, at0) and not_stlc) and rest_report().complete,
         detail=f"x1'=u, x2'=x1^2: rank {C.rank()} at 0, x2' >= 0 always; "
                f"bad [g,[f,g]] neutralised: {counter.all_bad_neutralised}; "
                f"this body at rest: Sussmann condition proven {rest_report().complete}",
     )
 
 
-def _check_conclusion() -> Verdict:
+def _stlc_claims(model):
+    """The sets of states where the conclusion claims STLC, as sympy conditions on
+    (v1, v2, omega): as printed (omega != a m v2 / I_C) and as corrected (at rest)."""
+    _, _, _, V1, V2, W = model.q
+    p = model.params
+    return (sp.Ne(W, p["a"] * p["m"] / p["I"] * V2),
+            sp.And(sp.Eq(V1, 0), sp.Eq(V2, 0), sp.Eq(W, 0)))
+
+
+def _claims_moving_state(claim, model) -> bool:
+    """Whether ``claim`` includes a state where the body moves: tried at the unit
+    velocities along each axis, both signs, and on the printed excluded line, with the
+    Table's parameters."""
+    _, _, _, V1, V2, W = model.q
+    p = model.params
+    b = Body()
+    vals = {p["m"]: b.m, p["I"]: b.I, p["a"]: b.a, p["c"]: b.c, p["c_phi"]: b.c_phi}
+    points = [(s * e[0], s * e[1], s * e[2]) for e in ((1, 0, 0), (0, 1, 0), (0, 0, 1)) for s in (1, -1)]
+    points.append((0, 1, b.a * b.m / b.I))
+    return any(bool(sp.sympify(claim).subs(vals).subs({V1: v1, V2: v2, W: w})) for v1, v2, w in points)
+
+
+def _check_conclusion(printed=None, corrected=None) -> Verdict:
+    """``printed`` and ``corrected`` are the sets of states where STLC is claimed, as sympy
+    conditions on (v1, v2, omega) (defaults :func:`_stlc_claims`). A claim fails if it
+    includes a moving state (there the configuration moves whatever the bounded inputs);
+    the corrected one must also include the rest state (Sussmann's condition proven
+    there) and come with strong accessibility at every state."""
     model = derive_body_frame()
     _, _, _, V1, V2, W = model.q
     p = model.params
+    printed_claim, corrected_claim = _stlc_claims(model)
+    printed = printed_claim if printed is None else printed
+    corrected = corrected_claim if corrected is None else corrected
     # configuration rates (rows 1-3) are free of the inputs and vanish only at rest
     inputs_free = all(e == 0 for e in list(model.g1[:3]) + list(model.g2[:3]))
     rest = sp.solve(list(model.f[:3]), [V1, V2, W], dict=True)
     only_rest = rest == [{V1: 0, V2: 0, W: 0}]
-    rest_in_set = sp.simplify(W - p["a"] * p["m"] / p["I"] * V2).subs({V1: 0, V2: 0, W: 0}) == 0
+    moving_not_stlc = inputs_free and only_rest
     det = strong_accessibility_det()
     everywhere = det.free_symbols <= set(p.values()) and det != 0
+    corrected_at_rest = bool(sp.sympify(corrected).subs({V1: 0, V2: 0, W: 0}))
     return Verdict(
-        printed_holds=not (inputs_free and only_rest and rest_in_set),
-        corrected_holds=bool(everywhere) and rest_report().complete,
+        printed_holds=not (moving_not_stlc and _claims_moving_state(printed, model)),
+        corrected_holds=(bool(everywhere) and rest_report().complete and corrected_at_rest
+                         and not (moving_not_stlc and _claims_moving_state(corrected, model))),
         detail=f"off the printed set the configuration always moves (rest only at {rest}); "
                f"det of strong-accessibility brackets = {sp.sstr(det)}; "
                f"Sussmann at rest proven: {rest_report().complete}",
     )
 
 
-def _check_f1_name() -> Verdict:
+def _check_f1_name(printed=None, corrected=None) -> Verdict:
+    """The line "Also: [X, [g1, g2]] = 0": ``printed`` and ``corrected`` are the field X
+    (defaults f_1 of eq. (1), a 3-vector of accelerations, and the drift f of (5)); each
+    holds if the bracket is defined on the 6-dimensional state and vanishes."""
     model = derive_body_frame()
     p = model.params
-    xd, yd, pd = sp.symbols("xdot ydot varphidot", real=True)
-    f1 = sp.Matrix([-p["c"] / p["m"] * xd, -p["c"] / p["m"] * yd, -p["c_phi"] / p["I"] * pd])  # eq. (1)
     fields = model_fields(model)
+    if printed is None:
+        xd, yd, pd = sp.symbols("xdot ydot varphidot", real=True)
+        printed = sp.Matrix([-p["c"] / p["m"] * xd, -p["c"] / p["m"] * yd, -p["c_phi"] / p["I"] * pd])  # eq. (1)
+    corrected = fields["f"] if corrected is None else corrected
     g1g2 = evaluate_bracket(("g1", "g2"), fields, model.q)
-    try:
-        lie_bracket(f1, g1g2, model.q)
-        printed = True
-    except ValueError:
-        printed = False
-    corrected = evaluate_bracket(("f", ("g1", "g2")), fields, model.q)
+
+    def vanishes(X) -> bool:
+        try:
+            return all(sp.simplify(e) == 0 for e in lie_bracket(X, g1g2, model.q))
+        except ValueError:  # not a field on the state: the bracket is undefined
+            return False
+
     return Verdict(
-        printed_holds=printed,
-        corrected_holds=all(e == 0 for e in corrected),
+        printed_holds=vanishes(printed),
+        corrected_holds=vanishes(corrected),
         detail="f_1 of eq. (1) is a 3-vector (accelerations): [f_1, .] on the 6-dim state is undefined; "
                "[f, [g1, g2]] = 0",
     )
@@ -161,22 +240,27 @@ def _entry_rows():
     return out
 
 
-def _check_rank_condition():
-    """The paper's exceptional set omega = a m v2 / I_C against the zero set of det C,
-    with the printed columns of (21) and with the derived ones."""
+def _check_rank_condition(printed=None, corrected=None):
+    """The paper's exceptional set omega = a m v2 / I_C against the zero set of det C:
+    ``printed`` and ``corrected`` are det C (defaults from
+    :func:`lib.symbolic.rank_determinants`: with the printed columns of (21), with the
+    derived ones); each holds if it is the claim times a nonzero constant."""
     model = derive_body_frame()
     p = model.params
     _, _, _, _, v2, w = model.q
     claim = p["a"] * p["m"] * v2 - p["I"] * w
-    dets = rank_determinants(model)
+    if printed is None or corrected is None:
+        dets = rank_determinants(model)
+        printed = dets["printed"] if printed is None else printed
+        corrected = dets["derived"] if corrected is None else corrected
 
     def matches(det):  # det C = const * claim with a nonzero constant free of the state
         ratio = sp.simplify(det / claim)
         return not ratio.free_symbols & set(model.q) and ratio != 0
 
-    return Verdict(printed_holds=matches(dets["printed"]), corrected_holds=matches(dets["derived"]),
-                   detail=f"det C with the printed columns: {sp.sstr(dets['printed'])}; "
-                          f"with the derived ones: {sp.sstr(dets['derived'])}")
+    return Verdict(printed_holds=matches(printed), corrected_holds=matches(corrected),
+                   detail=f"det C with the printed columns: {sp.sstr(printed)}; "
+                          f"with the derived ones: {sp.sstr(corrected)}")
 
 
 def _errata():

@@ -22,46 +22,71 @@ def _table_values():
             s["Theta"]: sp.pi / 4}
 
 
-def _check_eq33():
+def _check_eq33(printed=None, corrected=None):
+    """(33): ``printed`` and ``corrected`` are the right side of v_p' (defaults
+    :func:`lib.rotation_equations.printed_eq33` and the same with the sign of its
+    cos p term flipped); each holds if it equals the derivation."""
     eq = derive_rotation_equation()
-    diff = sp.simplify(printed_eq33() - eq.rhs)
     s = eq.params
-    corrected = printed_eq33() + 2 * s["a"] * s["m"] * s["Theta"] ** 2 * s["R"] / s["I"] * sp.cos(eq.p)
+    if printed is None:
+        printed = printed_eq33()
+    if corrected is None:
+        corrected = printed_eq33() + 2 * s["a"] * s["m"] * s["Theta"] ** 2 * s["R"] / s["I"] * sp.cos(eq.p)
+    diff = sp.simplify(printed - eq.rhs)
     return Verdict(printed_holds=diff == 0, corrected_holds=sp.simplify(corrected - eq.rhs) == 0,
                    detail=f"printed minus derived v_p' = {sp.sstr(diff)}")
 
 
-def _check_p0():
+def _check_p0(printed=None, corrected=None):
+    """The equilibria of (33): ``printed`` and ``corrected`` are functions k -> p0^(k)
+    (defaults :func:`lib.rotation_equations.printed_p0`, ``corrected_p0``); each holds
+    if the derived (33) at rest vanishes there for k = 0, 1 (the corrected one
+    symbolically too)."""
+    printed = printed_p0 if printed is None else printed
+    corrected = corrected_p0 if corrected is None else corrected
     eq = derive_rotation_equation()
     at_rest = eq.rhs.subs(eq.v_p, 0)
-    corrected_ok = all(sp.simplify(sp.expand_trig(at_rest.subs(eq.p, corrected_p0(k)))) == 0 for k in (0, 1))
+    corrected_ok = all(sp.simplify(sp.expand_trig(at_rest.subs(eq.p, corrected(k)))) == 0 for k in (0, 1))
     vals = _table_values()
-    res_printed = [float(sp.N(at_rest.subs(eq.p, printed_p0(k)).subs(vals))) for k in (0, 1)]
-    res_corr = [float(sp.N(at_rest.subs(eq.p, corrected_p0(k)).subs(vals))) for k in (0, 1)]
+    res_printed = [float(sp.N(at_rest.subs(eq.p, printed(k)).subs(vals))) for k in (0, 1)]
+    res_corr = [float(sp.N(at_rest.subs(eq.p, corrected(k)).subs(vals))) for k in (0, 1)]
     return Verdict(printed_holds=max(abs(r) for r in res_printed) < 1e-9,
                    corrected_holds=corrected_ok and max(abs(r) for r in res_corr) < 1e-12,
                    detail=(f"residual of the derived (33) at rest, Table values, k = 0, 1: printed p0 "
                            f"{res_printed[0]:.3g}, {res_printed[1]:.3g} rad/s^2; corrected p0 zero symbolically"))
 
 
-def _check_eq37():
+def _check_eq37(printed=None, corrected=None):
+    """(37): ``printed`` and ``corrected`` are its right side (defaults
+    :func:`lib.rotation_equations.printed_eq37` with the bracket as printed and as
+    corrected); each holds if it equals the derivation."""
     _, torque, _ = derive_eight_equation()
-    diff = sp.simplify(sp.expand(printed_eq37(True) - torque))
+    printed = printed_eq37(True) if printed is None else printed
+    corrected = printed_eq37(False) if corrected is None else corrected
+    diff = sp.simplify(sp.expand(printed - torque))
     return Verdict(printed_holds=diff == 0,
-                   corrected_holds=sp.simplify(sp.expand(printed_eq37(False) - torque)) == 0,
+                   corrected_holds=sp.simplify(sp.expand(corrected - torque)) == 0,
                    detail=f"printed minus derived right side is nonzero: {sp.sstr(sp.factor(diff))}")
 
 
-def _check_fourier_digits():
+#: the tangent angle's series with a3 corrected: the computed coefficients to two decimals
+CORRECTED_HEADING_SERIES = {1: -2.26, 3: -0.23, 5: 0.16}
+
+
+def _check_fourier_digits(printed=None, corrected=None):
     """The printed coefficients of the tangent angle's 3-term series against the
-    computed ones rounded to the printed two decimals, compared as whole hundredths."""
+    computed ones rounded to the printed two decimals, compared as whole hundredths.
+    ``printed`` and ``corrected`` map k = 1, 3, 5 to a_k (defaults
+    :data:`lib.trajectories.PAPER_HEADING_SERIES`, :data:`CORRECTED_HEADING_SERIES`)."""
+    printed = PAPER_HEADING_SERIES if printed is None else printed
+    corrected = CORRECTED_HEADING_SERIES if corrected is None else corrected
     a = eight_heading_fourier(5)
     computed = {k: int(round(100 * a[k])) for k in (1, 3, 5)}
-    printed = {k: int(round(100 * PAPER_HEADING_SERIES[k])) for k in (1, 3, 5)}
-    corrected = {1: -226, 3: -23, 5: 16}
-    return Verdict(printed_holds=printed == computed, corrected_holds=corrected == computed,
+    printed_h = {k: int(round(100 * printed[k])) for k in (1, 3, 5)}
+    corrected_h = {k: int(round(100 * corrected[k])) for k in (1, 3, 5)}
+    return Verdict(printed_holds=printed_h == computed, corrected_holds=corrected_h == computed,
                    detail=(f"computed a1, a3, a5 = {a[1]:.4f}, {a[3]:.4f}, {a[5]:.4f}; in hundredths "
-                           f"{computed}, printed {printed}"))
+                           f"{computed}, printed {printed_h}"))
 
 
 def _errata():

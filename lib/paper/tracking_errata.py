@@ -19,14 +19,17 @@ PAPER_TABLE_LINES = (
 )
 
 
-def _check_table_number(lines=PAPER_TABLE_LINES):
-    """The paper's only table is captioned "Table 5"; the text refers to it as "Tab. 1"."""
+def _check_table_number(lines=PAPER_TABLE_LINES, printed=5, corrected=1):
+    """The paper's only table is captioned "Table 5"; the text refers to it as "Tab. 1".
+    ``printed`` and ``corrected`` are the table's number: a caption "Table k" is right
+    only if the paper has at least k tables; the corrected number must also be the
+    count of tables (one here) and the number every text reference cites."""
     captions = [m.group(0) for line in lines if (m := re.match(r"Table\s+\d+", line))]
     refs = [r for line in lines for r in re.findall(r"Tab\.\s*\d+", line)]
     n_tables = len(captions)
-    # a caption "Table 5" is right only if the paper had at least five tables
-    return Verdict(printed_holds=n_tables >= 5,
-                   corrected_holds=n_tables == 1 and all(r.endswith("1") for r in refs),
+    cited = [int(re.search(r"\d+$", r).group(0)) for r in refs]
+    return Verdict(printed_holds=n_tables >= printed,
+                   corrected_holds=n_tables == corrected and all(k == corrected for k in cited),
                    detail=f"table captions {captions}, text references {refs}: {n_tables} table(s)")
 
 
