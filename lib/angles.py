@@ -10,7 +10,10 @@ __all__ = ["wrap_angle", "state_difference"]
 def wrap_angle(angle) -> np.ndarray:
     """Wrap angles (rad) to the interval (-pi, pi]."""
     angle = np.asarray(angle, dtype=float)
-    return np.pi - np.mod(np.pi - angle, 2 * np.pi)
+    w = np.pi - np.mod(np.pi - angle, 2 * np.pi)
+    # a hair above an odd multiple of pi, pi - angle is a hair below a multiple of 2 pi and
+    # its remainder rounds up to 2 pi itself: w = -pi, outside the interval; it is the angle pi
+    return np.where(w == -np.pi, np.pi, w)[()]
 
 
 def state_difference(a, b) -> np.ndarray:

@@ -130,6 +130,16 @@ def test_wrap_angle_keeps_pi_and_sends_minus_pi_to_pi():
     assert -np.pi < w <= np.pi and abs(np.angle(np.exp(1j * (w - np.nextafter(-np.pi, 0))))) < 1e-15
 
 
+def test_wrap_angle_of_an_angle_a_hair_above_pi_is_pi_not_minus_pi():
+    # pi - a is then a hair below zero and its remainder mod 2 pi rounds to 2 pi itself:
+    # the bare formula gave -pi, outside (-pi, pi] (hypothesis found it through
+    # control.allocate with tau = [-1, 0, 0], phi = -3.5e-16)
+    for a in (np.pi + 3.5e-16, np.nextafter(np.pi, 4), 3 * np.pi + 1e-15, -np.pi + 1e-17):
+        w = wrap_angle(a)
+        assert -np.pi < w <= np.pi, (a, w)
+    assert wrap_angle(np.array([np.pi + 3.5e-16]))[0] == np.pi
+
+
 def test_wrap_angle_lands_in_the_half_open_interval_for_large_multiples():
     k = np.array([1, 2, 3, 10, 1000, 10**6, -1, -2, -3, -10, -1000, -10**6])
     for base in (0.3, -2.9, np.pi - 1e-9):
