@@ -137,7 +137,7 @@ def circle_final_state(body: Body, R, theta, p0=0.0, v0=0.0, t_end: float = 300.
                         rtol=rtol, atol=atol, t_eval=[span / 2, span])
         mid, p[todo], v[todo] = sol.y[:n, 0], sol.y[:n, -1], sol.y[n:, -1]
         t_used[todo] += span
-        gap = np.abs(np.remainder(p[todo] - ps[todo] + np.pi, 2 * np.pi) - np.pi)
+        gap = np.abs(wrap_angle(p[todo] - ps[todo]))
         settled = (gap < 1e-4) & (np.abs(v[todo]) < 1e-4)
         slipping = ~settled & (np.abs(p[todo] - mid) > 2 * np.pi)
         regime[todo[settled]] = "settled"

@@ -83,22 +83,20 @@ class Regime:
 
 
 def classify(period: int, lyapunov: float, stderr: float, *, zero_band: float = 0.01) -> str:
-    """Verdict from a section period (:func:`section_period`, 0 = none found) and the
-    largest Lyapunov exponent (1/s) with its standard error.
-
-    "chaotic" when the exponent exceeds both ``zero_band`` and three standard
-    errors; otherwise "periodic-k" when the section has period k; otherwise
-    "quasi-periodic" when the exponent is known to be within ``zero_band`` of
-    zero (|lambda| and its standard error both below ``zero_band``); otherwise
-    "undecided" (the estimate is too noisy to decide).
+    """Verdict of the adaptive reference path (:func:`sweep_angle_limit`, which does not
+    locate orbits) from a section period (:func:`section_period`, 0 = none found) and the
+    largest Lyapunov exponent (1/s) with its standard error, by the book's rule
+    (:func:`lib.dynamics.verdicts.classify`, band ``zero_band``; the section's closure is
+    not tested on this path): "chaotic"; otherwise "periodic-k" when the section has
+    period k; otherwise "quasi-periodic" when the exponent is known to be within the band
+    of zero; otherwise "undecided" (the estimate is too noisy to decide).
     """
-    if lyapunov > max(zero_band, 3 * stderr):
+    regime = dv.classify([lyapunov], [stderr], [0.0], band=zero_band, return_tol=1.0, max_period=8)[0][0]
+    if regime == "chaotic":
         return "chaotic"
     if period > 0:
         return f"periodic-{period}"
-    if abs(lyapunov) < zero_band and stderr < zero_band:
-        return "quasi-periodic"
-    return "undecided"
+    return "quasi-periodic" if regime == "quasiperiodic" else "undecided"
 
 
 def _section_one(args):

@@ -392,7 +392,7 @@ def _on_fine_map(body, kind, R, Theta, n_pts, n_fine, opts, engine, out) -> None
             A, B, C = coefficients(body, R[g], Theta[g])
             if np.any(n_pts[g] != n):
                 rmap = RotationMap(eng, A, B, C)
-                x, J, res, _ = dv.newton(rmap.step, np.arange(g.size), out["x"][g], int(k), turn_axis=0,
+                x, J, res, _, _ = dv.newton(rmap.step, np.arange(g.size), out["x"][g], int(k), turn_axis=0,
                                          turns=out["slip_n"][g], tol=opts["newton_tol"], **_NEWTON)
                 ok = res <= opts["newton_tol"]
                 mult = np.full((g.size, 2), np.nan + 0j)

@@ -26,12 +26,12 @@ dimensionless (the rate d phi / dt divided by Theta).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, NamedTuple
 
 import numpy as np
 
 
-__all__ = ["Orbit", "newton_orbit", "floquet_multipliers", "MapWithJacobian"]
+__all__ = ["Orbit", "newton", "NewtonResult", "newton_orbit", "floquet_multipliers", "MapWithJacobian"]
 
 MapWithJacobian = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
 
@@ -74,6 +74,70 @@ def floquet_multipliers(jacobian) -> np.ndarray:
     return np.take_along_axis(lam, order, axis=-1)
 
 
+class NewtonResult(NamedTuple):
+    """What :func:`newton` returns for M rows: the iterate ``x`` (M, d), ``jacobian`` DP^k
+    there (M, d, d), ``residual`` (M,), ``turns`` n (M,), ``iterations`` (M,)."""
+
+    x: np.ndarray
+    jacobian: np.ndarray
+    residual: np.ndarray
+    turns: np.ndarray
+    iterations: np.ndarray
+
+
+def newton(step: Callable, idx, x0, k, *, turn_axis: int = 0, turns=None, tol: float, max_iter: int,
+           max_step: float = 1.0, stall_after: int | None = None, polish: float | None = None):
+    """Orbits of period k: Newton on G(x) = P^k(x) - x - 2 pi n e_turn for many rows.
+
+    ``step(idx, x, k) -> (P^k(x), DP^k)`` for the rows ``idx`` (the map's exact
+    Jacobian, or :func:`difference_jacobian`). ``turns``: the whole turns n per row
+    (M,), or None to take n afresh at every iterate as the turns P^k(x) - x is nearest
+    to. Steps longer than ``max_step`` (max-norm) are cut back to it. A row goes on
+    while its residual exceeds ``tol`` (after ``stall_after`` iterations, only while
+    it at least halves) and, below ``tol``, while it is above ``polish`` and still
+    halves; at most ``max_iter`` steps. Returns a :class:`NewtonResult`: x (M, d), DP^k
+    (M, d, d) at the last iterate, the residual (M,) (max-norm; NaN where a step was not
+    finite), the turns n (M,) and the steps taken (M,)."""
+    x = np.array(x0, dtype=float)
+    M, d = x.shape
+    idx = np.asarray(idx)
+    k = np.broadcast_to(np.asarray(k, dtype=int), (M,))
+    fixed = turns is not None
+    n = np.broadcast_to(np.asarray(turns if fixed else 0), (M,)).astype(int)
+    polish = tol if polish is None else polish
+    stall = np.inf if stall_after is None else stall_after
+    J = np.tile(np.eye(d), (M, 1, 1))
+    res, prev = np.full(M, np.inf), np.full(M, np.inf)
+    its = np.zeros(M, int)
+    eye = np.eye(d)
+    todo = np.arange(M)
+    for it in range(max_iter + 1):
+        y, Jt = step(idx[todo], x[todo], k[todo])
+        G = y - x[todo]
+        if not fixed:
+            n[todo] = np.rint(G[:, turn_axis] / (2 * np.pi)).astype(int)
+        G[:, turn_axis] -= (2 * np.pi) * n[todo]
+        r = np.abs(G).max(axis=1)
+        J[todo], res[todo] = Jt, r
+        halving = r < 0.5 * prev[todo]
+        go = np.isfinite(r) & (((r > tol) & ((it < stall) | halving)) | ((r > polish) & halving))
+        prev[todo] = r
+        if it == max_iter or not go.any():
+            break
+        with np.errstate(all="ignore"):
+            dx = np.linalg.solve(Jt[go] - eye, -G[go][..., None])[..., 0]
+        dx /= np.maximum(1.0, np.abs(dx).max(axis=1) / max_step)[:, None]
+        bad = ~np.all(np.isfinite(dx), axis=1)
+        t = todo[go]
+        x[t] += np.where(bad[:, None], 0.0, dx)
+        its[t] += 1
+        res[t[bad]] = np.nan
+        todo = t[~bad]
+        if todo.size == 0:
+            break
+    return NewtonResult(x, J, res, n, its)
+
+
 def _power(step: MapWithJacobian, x: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
     """P^k(x) and its Jacobian by the chain rule, for points x of shape (N, d)."""
     J = np.broadcast_to(np.eye(x.shape[1]), (x.shape[0],) + (x.shape[1],) * 2).copy()
@@ -93,7 +157,7 @@ def newton_orbit(step: MapWithJacobian, x0, k: int = 1, shift=0.0, *, tol: float
     a repeating motion). Newton steps longer than ``max_step`` (max-norm) are
     cut back to it, which keeps a far start from jumping across the phase
     space. Points whose residual falls to ``tol`` stop; the rest stop after
-    ``max_iter`` steps with ``converged`` False.
+    ``max_iter`` steps with ``converged`` False. (:func:`newton` on the map less its shift.)
     """
     if not isinstance(k, (int, np.integer)) or k < 1:
         raise ValueError(f"period k must be a positive integer, got {k!r}")
@@ -104,23 +168,12 @@ def newton_orbit(step: MapWithJacobian, x0, k: int = 1, shift=0.0, *, tol: float
         raise ValueError("tol and max_step must be positive")
     N, d = x.shape
     shift = np.broadcast_to(np.asarray(shift, dtype=float), (N, d))
-    J = np.empty((N, d, d))
-    res = np.full(N, np.inf)
-    its = np.zeros(N, dtype=int)
-    todo = np.arange(N)
-    for it in range(max_iter + 1):
-        y, Jt = _power(step, x[todo], k)
-        G = y - x[todo] - shift[todo]
-        J[todo] = Jt
-        res[todo] = np.max(np.abs(G), axis=1)
-        done = ~(res[todo] > tol)  # NaN residuals count as done (and not converged)
-        todo_next = todo[~done]
-        if it == max_iter or todo_next.size == 0:
-            break
-        Gk, Jk = G[~done], Jt[~done]
-        dx = np.linalg.solve(Jk - np.eye(d), -Gk[..., None])[..., 0]
-        scale = np.maximum(1.0, np.max(np.abs(dx), axis=1) / max_step)
-        x[todo_next] += dx / scale[:, None]
-        its[todo_next] += 1
-        todo = todo_next
-    return Orbit(x=x, jacobian=J, residual=res, converged=res <= tol, iterations=its)
+
+    def shifted(idx, y, kk):
+        Pk, J = _power(step, y, int(kk[0]))
+        return Pk - shift[idx], J
+
+    r = newton(shifted, np.arange(N), x, k, turns=np.zeros(N, int), tol=tol, max_iter=max_iter, max_step=max_step)
+    with np.errstate(invalid="ignore"):
+        converged = r.residual <= tol
+    return Orbit(x=r.x, jacobian=r.jacobian, residual=r.residual, converged=converged, iterations=r.iterations)

@@ -44,9 +44,9 @@ from typing import Callable, Protocol
 import numpy as np
 
 from ..angles import wrap_angle
-from .orbits import floquet_multipliers
+from .orbits import NewtonResult, floquet_multipliers, newton
 
-__all__ = ["REGIMES", "SIGMAS", "PeriodMap", "lag_candidates", "difference_jacobian", "newton", "least_period",
+__all__ = ["REGIMES", "SIGMAS", "PeriodMap", "lag_candidates", "difference_jacobian", "newton", "NewtonResult", "least_period",
            "distance_to_orbit", "reached", "block_statistics", "batch_means", "drift_statistics", "section_returns", "classify",
            "heading_lost", "orbit_regime", "orbit_points", "find_orbits", "enclosed_orbit"]
 
@@ -108,56 +108,6 @@ def difference_jacobian(pmap: PeriodMap, idx, x, k, h: float) -> tuple[np.ndarra
     Y = pmap.advance(np.tile(np.asarray(idx), d + 1), X, np.tile(k, d + 1))
     J = np.stack([(Y[(j + 1) * M:(j + 2) * M] - Y[:M]) / h for j in range(d)], axis=-1)
     return Y[:M], J
-
-
-def newton(step: Callable, idx, x0, k, *, turn_axis: int, turns=None, tol: float, max_iter: int,
-           max_step: float = 1.0, stall_after: int | None = None, polish: float | None = None):
-    """Orbits of period k: Newton on G(x) = P^k(x) - x - 2 pi n e_heading for many rows.
-
-    ``step(idx, x, k) -> (P^k(x), DP^k)`` for the rows ``idx`` (the map's exact
-    Jacobian, or :func:`difference_jacobian`). ``turns``: the whole turns n per row
-    (M,), or None to take n afresh at every iterate as the turns P^k(x) - x is nearest
-    to. Steps longer than ``max_step`` (max-norm) are cut back to it. A row goes on
-    while its residual exceeds ``tol`` (after ``stall_after`` iterations, only while
-    it at least halves) and, below ``tol``, while it is above ``polish`` and still
-    halves; at most ``max_iter`` steps. Returns x (M, d), DP^k (M, d, d) at the last
-    iterate, the residual (M,) (max-norm; NaN where a step was not finite) and n (M,)."""
-    x = np.array(x0, dtype=float)
-    M, d = x.shape
-    idx = np.asarray(idx)
-    k = np.broadcast_to(np.asarray(k, dtype=int), (M,))
-    fixed = turns is not None
-    n = np.broadcast_to(np.asarray(turns if fixed else 0), (M,)).astype(int)
-    polish = tol if polish is None else polish
-    stall = np.inf if stall_after is None else stall_after
-    J = np.tile(np.eye(d), (M, 1, 1))
-    res, prev = np.full(M, np.inf), np.full(M, np.inf)
-    eye = np.eye(d)
-    todo = np.arange(M)
-    for it in range(max_iter + 1):
-        y, Jt = step(idx[todo], x[todo], k[todo])
-        G = y - x[todo]
-        if not fixed:
-            n[todo] = np.rint(G[:, turn_axis] / TWO_PI).astype(int)
-        G[:, turn_axis] -= TWO_PI * n[todo]
-        r = np.abs(G).max(axis=1)
-        J[todo], res[todo] = Jt, r
-        halving = r < 0.5 * prev[todo]
-        go = np.isfinite(r) & (((r > tol) & ((it < stall) | halving)) | ((r > polish) & halving))
-        prev[todo] = r
-        if it == max_iter or not go.any():
-            break
-        with np.errstate(all="ignore"):
-            dx = np.linalg.solve(Jt[go] - eye, -G[go][..., None])[..., 0]
-        dx /= np.maximum(1.0, np.abs(dx).max(axis=1) / max_step)[:, None]
-        bad = ~np.all(np.isfinite(dx), axis=1)
-        t = todo[go]
-        x[t] += np.where(bad[:, None], 0.0, dx)
-        res[t[bad]] = np.nan
-        todo = t[~bad]
-        if todo.size == 0:
-            break
-    return x, J, res, n
 
 
 def least_period(x, pts, k, n, *, turn_axis: int, turns=True, tol: float):
@@ -336,8 +286,8 @@ def find_orbits(step: Callable, pmap: PeriodMap, idx, hist, *, max_period: int, 
         c = np.flatnonzero(cand[kk - 1] & ~out["found"] & ~waiting[kk - 1])
         if c.size == 0:
             continue
-        x, J, res, n = newton(step, idx[c], hist[-1, c], kk, turn_axis=ax,
-                              turns=nslip[kk - 1, c] if fixed_turns else None, tol=newton_tol, **newton_options)
+        x, J, res, n, _ = newton(step, idx[c], hist[-1, c], kk, turn_axis=ax,
+                                 turns=nslip[kk - 1, c] if fixed_turns else None, tol=newton_tol, **newton_options)
         if tried is not None:
             tried[kk - 1, c] = defect[kk - 1, c]
         ok = res <= newton_tol
@@ -394,7 +344,7 @@ def enclosed_orbit(step: Callable, idx, sec, *, turn_axis: int, newton_tol: floa
     sec = np.asarray(sec, dtype=float)
     x0 = sec.mean(axis=0)
     x0[:, turn_axis] = np.angle(np.exp(1j * sec[:, :, turn_axis]).mean(axis=0))
-    _, J, res, _ = newton(step, idx, x0, 1, turn_axis=turn_axis, tol=newton_tol, **newton_options)
+    _, J, res, _, _ = newton(step, idx, x0, 1, turn_axis=turn_axis, tol=newton_tol, **newton_options)
     ok = res <= newton_tol
     mu = np.full(ok.size, np.nan)
     if ok.any():

@@ -1,0 +1,177 @@
+"""The one decision procedure (lib.dynamics.verdicts): each step and each definition at
+its boundary, on inputs whose answer is known without the procedure."""
+
+import math
+
+import numpy as np
+import pytest
+
+from lib import limits, loop_verdicts, rotation_verdicts, stability
+from lib.circle_rotation import circle_critical_radius, circle_eigenvalues
+from lib.dynamics import verdicts as dv
+from lib.params import Body
+from lib.rotation_engine import RotationMap, _Engine
+from lib.rotation_field import coefficients
+
+BODY = Body()
+
+
+# ---------------------------------------------------------------- the rule, at its boundaries
+
+@pytest.mark.parametrize("factor, regime", [(1.001, "chaotic"), (0.999, "undecided")])
+def test_chaotic_needs_the_exponent_three_standard_errors_above_zero(factor, regime):
+    # lambda T = 0.05 clears the band (0.01); it is chaotic exactly when it clears 3 SE too
+    lam = 0.05
+    se = lam / (dv.SIGMAS * factor)
+    got, reason = dv.classify([lam], [se], [np.inf], band=0.01, return_tol=0.05, max_period=8)
+    assert got[0] == regime
+    assert (reason[0] == "") == (regime == "chaotic")
+
+
+def test_one_standard_error_is_not_enough_for_chaos():
+    # 2.1 sigma (the point a 1-sigma rule would call chaotic) stays undecided
+    got, _ = dv.classify([0.021], [0.01], [np.inf], band=0.01, return_tol=0.05, max_period=8)
+    assert got[0] == "undecided"
+
+
+@pytest.mark.parametrize("lam, regime", [(0.0101, "chaotic"), (0.0099, "quasiperiodic")])
+def test_the_band_separates_chaos_from_a_zero_exponent(lam, regime):
+    # a tiny standard error: only the band decides; a closed section makes the zero quasi-periodic
+    got, _ = dv.classify([lam], [1e-5], [0.01], band=0.01, return_tol=0.05, max_period=8)
+    assert got[0] == regime
+
+
+@pytest.mark.parametrize("se, returns, regime", [
+    (0.0033, 0.01, "quasiperiodic"),     # SE <= band / 3, section closed
+    (0.0034, 0.01, "undecided"),         # SE just above band / 3
+    (0.0010, 0.06, "undecided"),         # section does not return within 0.05
+])
+def test_quasiperiodic_needs_a_resolved_zero_and_a_closed_section(se, returns, regime):
+    got, reason = dv.classify([0.0], [se], [returns], band=0.01, return_tol=0.05, max_period=8)
+    assert got[0] == regime
+    if regime == "undecided" and returns > 0.05:
+        assert "does not return" in reason[0]
+
+
+def test_a_contracting_run_without_an_orbit_is_undecided_and_says_so():
+    got, reason = dv.classify([-0.2], [0.01], [np.inf], band=0.01, return_tol=0.05, max_period=8)
+    assert got[0] == "undecided" and reason[0].startswith("contracting")
+
+
+@pytest.mark.parametrize("drift, se, lost", [(0.0, 0.0, False), (0.0041, 0.001, True), (0.0039, 0.001, False),
+                                             (-0.5, 0.01, True)])
+def test_heading_lost_when_it_drifts_by_more_than_three_errors_plus_the_band(drift, se, lost):
+    # no orbit, range within a turn: lost iff |drift| > 3 SE + slip_band (1e-3 turns per period)
+    got = dv.heading_lost([False], [0], [drift], [se], [1.0], slip_band=1e-3)
+    assert bool(got[0]) is lost
+
+
+def test_heading_lost_on_an_orbit_exactly_when_it_slips():
+    got = dv.heading_lost([True, True], [0, -1], [np.nan, np.nan], [np.nan, np.nan], [30.0, 1.0], slip_band=1e-3)
+    assert got.tolist() == [False, True]
+
+
+def test_every_flow_names_the_regimes_of_the_one_procedure():
+    assert rotation_verdicts.REGIMES is dv.REGIMES
+    assert stability.REGIMES is dv.REGIMES
+    assert loop_verdicts.dv is dv and limits.dv is dv
+
+
+# ---------------------------------------------------------------- statistics
+
+def test_block_statistics_are_the_mean_and_error_of_the_block_means():
+    rng = np.random.default_rng(1)
+    v = rng.normal(0.3, 1.0, size=(3, 50))          # 4 blocks of 12, the first 2 periods dropped
+    mean, se = dv.block_statistics(v, 12)
+    for i in range(3):
+        means = [v[i, 2 + 12 * b: 2 + 12 * (b + 1)].mean() for b in range(4)]
+        assert mean[i] == pytest.approx(np.mean(means), rel=1e-14)
+        assert se[i] == pytest.approx(np.std(means, ddof=1) / 2.0, rel=1e-12)
+    with pytest.raises(ValueError, match="two blocks"):
+        dv.block_statistics(v[:, :20], 12)
+
+
+def test_drift_of_a_steady_slip_is_its_rate_with_zero_error():
+    # a heading gaining 0.25 turns per period, sampled at the ends of blocks of 6 periods
+    ends = 2 * np.pi * 0.25 * 6 * np.arange(9.0)
+    drift, se = dv.drift_statistics(ends[None], 6, 2 * np.pi)
+    assert drift[0] == pytest.approx(0.25, rel=1e-14) and se[0] == pytest.approx(0.0, abs=1e-14)
+
+
+# ---------------------------------------------------------------- orbits
+
+def _two_cycle(n_periods, turns_per_period=0):
+    """Sections of a period-2 motion: x alternates between 0.3 and -0.3, the heading gains
+    ``turns_per_period`` whole turns a period."""
+    j = np.arange(n_periods)
+    x = 0.3 * (-1.0) ** j
+    phi = 2 * np.pi * turns_per_period * j + 0.1
+    return np.stack([phi, x], axis=-1)[:, None, :]
+
+
+@pytest.mark.parametrize("turns", [0, 1])
+def test_lag_candidates_find_the_period_and_its_turns(turns):
+    ok, n, defect = dv.lag_candidates(_two_cycle(17, turns), 8, 1e-9, turn_axis=0)
+    assert ok[:, 0].tolist() == [False, True, False, True, False, True, False, True]
+    assert n[1, 0] == 2 * turns
+    assert defect[0, 0] == pytest.approx(0.6)
+    blocked, _, _ = dv.lag_candidates(_two_cycle(17, turns), 8, 1e-9, turn_axis=0, turns=False)
+    assert blocked[1, 0] == (turns == 0)
+
+
+def test_reached_asks_the_approach_to_be_as_fast_as_the_slowest_multiplier():
+    rho, k, m = 0.5, 1, 16
+    d_then = 1e-2
+    on_time = d_then * rho ** m
+    assert dv.reached([on_time], [d_then], [rho], m / k, tol=0.05, floor=1e-12)[0]
+    # ten times too slow for |mu| = 0.5: not reached, however small the distance
+    assert not dv.reached([10 * 3 * on_time], [d_then], [rho], m / k, tol=0.05, floor=1e-12)[0]
+    assert not dv.reached([0.06], [0.07], [0.999], m / k, tol=0.05, floor=1e-12)[0]     # beyond tol
+    assert dv.reached([1e-13], [1e-13], [0.999], m / k, tol=0.05, floor=1e-12)[0]       # on it
+
+
+def test_least_period_reduces_a_fixed_point_found_through_its_second_power():
+    x = np.array([[0.5, 0.0]])
+    pts = np.stack([x + [2 * np.pi, 0.0], x + [4 * np.pi, 0.0]])          # P(x) = x + 2 pi e_0
+    k, n = dv.least_period(x, pts, np.array([2]), np.array([2]), turn_axis=0, tol=1e-9)
+    assert (k[0], n[0]) == (1, 1)
+    k, n = dv.least_period(x, pts, np.array([2]), np.array([2]), turn_axis=0, turns=False, tol=1e-9)
+    assert (k[0], n[0]) == (2, 2)
+
+
+def test_newton_finds_the_fixed_point_of_a_contraction_and_its_turns():
+    # P(x) = (x0 + 2 pi + 0.5 sin x0 ... ): a standard-map-like step with a known fixed point at x0 = 0
+    def step(idx, x, k):
+        y = np.column_stack([x[:, 0] + 2 * np.pi + 0.5 * np.sin(x[:, 0]) + 0.1 * x[:, 1], 0.5 * x[:, 1]])
+        J = np.zeros((x.shape[0], 2, 2))
+        J[:, 0, 0], J[:, 0, 1], J[:, 1, 1] = 1 + 0.5 * np.cos(x[:, 0]), 0.1, 0.5
+        return y, J
+
+    r = dv.newton(step, np.arange(2), np.array([[0.4, 0.2], [-0.3, -0.1]]), 1, turn_axis=0, tol=1e-13,
+                  max_iter=30)
+    assert np.all(r.residual <= 1e-13)
+    assert np.allclose(r.x, 0.0, atol=1e-12) and r.turns.tolist() == [1, 1]
+    assert np.all(r.iterations >= 2)
+
+
+def test_difference_jacobian_is_the_exact_jacobian_of_the_rotation_map():
+    eng = _Engine("eight", 128, "numba")
+    A, B, C = coefficients(BODY, np.array([2.0, 1.0]), np.array([np.pi / 4, 1.2]))
+    rmap = RotationMap(eng, A, B, C)
+    x = np.array([[0.3, 1.1], [2.0, -0.4]])
+    y_exact, J_exact = rmap.step(np.arange(2), x, 1)
+    y_fd, J_fd = dv.difference_jacobian(rmap, np.arange(2), x, 1, 1e-7)
+    assert np.array_equal(y_fd, y_exact)
+    # forward differences: error ~ h |P''| (measured 4e-7 at h = 1e-7)
+    assert np.abs(J_fd - J_exact).max() < 5e-6 * max(1.0, np.abs(J_exact).max())
+
+
+def test_the_circles_equilibrium_has_the_exponent_of_the_linearisation_34():
+    # the verdict's exponent of an orbit, ln|mu_1| / (k T), in 1/s, against the largest real
+    # part of the eigenvalues of (34): an independent route to the exponent and its scale
+    theta = math.pi / 4
+    R = 3.0 * circle_critical_radius(BODY, theta)
+    frame = rotation_verdicts.rotation_verdicts(BODY, "circle", [R], [theta])
+    assert frame.regime[0] == "periodic" and frame.period[0] == 1
+    expected = circle_eigenvalues(BODY, R, theta).real.max()
+    assert frame.lyapunov[0] == pytest.approx(expected, rel=1e-6)
