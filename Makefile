@@ -13,10 +13,18 @@ $(STAMP): requirements.txt pyproject.toml
 	$(BIN)/python -m pip install --quiet -r requirements.txt
 	touch $(STAMP)
 
+# The build's output goes to the terminal and to _build/build.log (its time set back to when
+# the build began), its exit status to _build/build.rc: `make test` reuses a build that is
+# current and reads its warnings from that log (tests/conftest.py, fixture built_book).
 book: $(STAMP)
-	$(BIN)/jupyter-book build --all -W -n --keep-going .
+	mkdir -p _build && rm -f _build/build.rc && touch _build/build.start
+	{ PYTHONWARNINGS=default $(BIN)/jupyter-book build --all -W -n --keep-going . 2>&1; \
+	  echo $$? > _build/build.rc; } | tee _build/build.log
+	touch -r _build/build.start _build/build.log
+	@test "$$(cat _build/build.rc)" = 0 || { echo "Book build failed (see _build/build.log)"; exit 1; }
 	@echo "Book built: $(CURDIR)/_build/html/index.html"
 
+# Reuses the book `make book` built when it is current, builds it otherwise (BOOK_REBUILD=1 forces).
 test: $(STAMP)
 	$(BIN)/python -m pytest
 

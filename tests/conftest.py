@@ -1,11 +1,13 @@
-"""Shared fixtures. The book is built once per test session, in the repository's
-own ``_build`` (the same output as ``make book``)."""
+"""Shared fixtures. The book is built at most once per test session, in the repository's
+own ``_build`` (the same output as ``make book``), and not at all when ``make book``
+left a current build there."""
 
 from __future__ import annotations
 
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -16,16 +18,60 @@ from lib.robustness import ROBUST_REL, perturbed
 ROOT = Path(__file__).resolve().parents[1]
 
 
+# What the book is built from: a build of _build/ older than any of these is stale.
+# (README.md is not part of the book: _config.yml excludes it.)
+BOOK_INPUTS = ("chapters/*.md", "*.md", "_config.yml", "_toc.yml", "references.bib",
+               "lib/**/*.py", "_static/*", "requirements.txt")
+BUILD_CMD = ["build", "--all", "-W", "-n", "--keep-going", "."]
+
+
+def _newest_book_input() -> tuple[float, Path]:
+    files = {f for pattern in BOOK_INPUTS for f in ROOT.glob(pattern) if f.is_file()}
+    files.discard(ROOT / "README.md")
+    newest = max(files, key=lambda f: f.stat().st_mtime)
+    return newest.stat().st_mtime, newest
+
+
+def _current_build() -> subprocess.CompletedProcess | None:
+    """The build in ``_build`` as a completed process (its exit status and real log) when
+    it is current, else None. ``make book`` and the fixture below both leave
+    ``_build/build.log`` (its time set to when the build began) and ``_build/build.rc``
+    (written when it ended); the build is current when its HTML was written between the
+    two and no input of the book changed after it began."""
+    build = ROOT / "_build"
+    # searchindex.js is written at the end of every build (index.html only once: a redirect)
+    log, rc, html = build / "build.log", build / "build.rc", build / "html" / "searchindex.js"
+    if not (log.is_file() and rc.is_file() and html.is_file()):
+        return None
+    began, ended, written = log.stat().st_mtime, rc.stat().st_mtime, html.stat().st_mtime
+    if not began <= written <= ended + 1.0:
+        return None                       # the HTML came from another build than the log
+    if _newest_book_input()[0] >= began:
+        return None                       # an input changed after the build began
+    return subprocess.CompletedProcess(["jupyter-book", *BUILD_CMD], int(rc.read_text().strip() or 1),
+                                       stdout=log.read_text(), stderr="")
+
+
 @pytest.fixture(scope="session")
 def built_book() -> subprocess.CompletedProcess:
-    """Run ``jupyter-book build --all -W -n --keep-going .`` and return the completed process."""
+    """The book built by ``jupyter-book build --all -W -n --keep-going .``: the one
+    ``make book`` left in ``_build`` when it is current (see ``_current_build``),
+    otherwise built now, leaving the same ``build.log`` and ``build.rc``.
+    ``BOOK_REBUILD=1`` forces a build."""
+    if os.environ.get("BOOK_REBUILD", "") in ("", "0") and (done := _current_build()) is not None:
+        return done
     exe = Path(sys.executable).with_name("jupyter-book")
     env = dict(os.environ, PYTHONWARNINGS="default")
-    proc = subprocess.run([str(exe), "build", "--all", "-W", "-n", "--keep-going", "."],
-                          cwd=ROOT, env=env, capture_output=True, text=True)
-    (ROOT / "_build").mkdir(exist_ok=True)
-    (ROOT / "_build" / "build.log").write_text(proc.stdout + "\n" + proc.stderr)
-    return proc
+    build = ROOT / "_build"
+    build.mkdir(exist_ok=True)
+    (build / "build.rc").unlink(missing_ok=True)
+    began = time.time()
+    proc = subprocess.run([str(exe), *BUILD_CMD], cwd=ROOT, env=env,
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    (build / "build.rc").write_text(f"{proc.returncode}\n")
+    (build / "build.log").write_text(proc.stdout)
+    os.utime(build / "build.log", (began, began))
+    return subprocess.CompletedProcess(proc.args, proc.returncode, stdout=proc.stdout, stderr="")
 
 
 # ------------------------------------------------------------------ robustness mode

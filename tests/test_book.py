@@ -1,14 +1,68 @@
-"""The book builds from scratch, executing every notebook, with Sphinx warnings as errors."""
+"""The book builds from scratch, executing every notebook, with Sphinx warnings as errors;
+and its sources read at 1280 px (code lines that fit their block)."""
 
 import re
+from pathlib import Path
 
 import pytest
+import yaml
 
-pytestmark = pytest.mark.book
+ROOT = Path(__file__).resolve().parents[1]
+# At 1280 px a code block of the book's theme holds 77 monospace characters, the block of
+# a hide-input cell (indented in its fold) 76: measured in Debian's chromium by
+# tests/test_browser.py, where a 78-character line scrolls by 6 px (77 by 7 px in a fold).
+CODE_WIDTH = 77
+FOLDED_CODE_WIDTH = 75
+HIDDEN_TAGS = {"remove-input", "remove-cell"}
 
 
+@pytest.mark.book
 def test_book_builds_with_no_warnings(built_book):
     log = built_book.stdout + built_book.stderr
     warnings = [line for line in log.splitlines() if re.search(r"\bWARNING\b|\bERROR\b", line)]
     assert built_book.returncode == 0, "jupyter-book build failed:\n" + log[-6000:]
     assert not warnings, "build printed warnings:\n" + "\n".join(warnings[:40])
+
+
+def code_cells(path: Path):
+    """(first line number, metadata, code lines) of each ``{code-cell}`` of a MyST notebook."""
+    lines = path.read_text().splitlines()
+    i = 0
+    while i < len(lines):
+        if not lines[i].startswith("```{code-cell}"):
+            i += 1
+            continue
+        j, meta = i + 1, {}
+        if j < len(lines) and lines[j].strip() == "---":
+            k = lines.index("---", j + 1)
+            meta = yaml.safe_load("\n".join(lines[j + 1:k])) or {}
+            j = k + 1
+        while j < len(lines) and lines[j].startswith(":"):
+            key, _, value = lines[j][1:].partition(":")
+            meta[key.strip()] = yaml.safe_load(value)
+            j += 1
+        start = j
+        while not lines[j].startswith("```"):
+            j += 1
+        yield start + 1, meta, lines[start:j]
+        i = j + 1
+
+
+NOTEBOOKS = sorted(ROOT.glob("chapters/*.md")) + [ROOT / "report.md", ROOT / "errata.md", ROOT / "intro.md"]
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.relative_to(ROOT).as_posix())
+def test_shown_code_lines_fit_a_code_block_at_1280px(path):
+    """Every code line the page shows (cells not tagged remove-input/remove-cell) is
+    at most CODE_WIDTH characters (FOLDED_CODE_WIDTH in a hide-input cell), so no cell
+    scrolls sideways."""
+    long = []
+    for first, meta, code in code_cells(path):
+        tags = set(meta.get("tags") or [])
+        if HIDDEN_TAGS & tags:
+            continue
+        width = FOLDED_CODE_WIDTH if "hide-input" in tags else CODE_WIDTH
+        long += [f"line {first + n}: {len(line)} > {width} characters: {line.strip()[:60]}..."
+                 for n, line in enumerate(code) if len(line) > width]
+    assert not long, (f"{path.relative_to(ROOT)}: code lines wider than their block at "
+                      "1280 px (break the call over lines):\n  " + "\n  ".join(long))

@@ -1,9 +1,18 @@
-"""Open every page of the built book in headless Chromium, offline, and check that
-it reads correctly: math typeset by the bundled MathJax, every image loaded, no
-request leaving the loopback address, and every glued number present in the text.
+"""Read every page of the built book in headless Chromium at 1280 px, offline, in one
+browser session, and check that it reads correctly:
 
-Needs Debian's ``chromium`` (``.ci/run`` installs it); without it the test is
-skipped with a message saying so.
+- math typeset by the bundled MathJax, every image loaded, no request leaving the
+  loopback address;
+- every glued number present in the text, and no raw ``{glue``, ``nan`` or ``None``
+  in the prose;
+- every Markdown table (in the text or emitted by a cell) rendered as a table;
+- no code line wider than its code block;
+- every figure's alt text a sentence, not a file name;
+- on the report page, every status one of those its legend defines.
+
+The pages are visited once (fixture ``pages``); each check is its own test, so a
+failure names the page and the check. Needs Debian's ``chromium`` (``.ci/run``
+installs it); without it the tests are skipped with a message saying so.
 """
 
 from __future__ import annotations
@@ -14,6 +23,8 @@ import json
 import re
 import shutil
 import threading
+import time
+from dataclasses import dataclass, field
 from pathlib import Path
 from urllib.parse import urlparse
 
@@ -23,9 +34,12 @@ import yaml
 pytestmark = pytest.mark.browser
 
 ROOT = Path(__file__).resolve().parents[1]
-HTML = ROOT / "_build" / "html"
+BUILD = ROOT / "_build"
+HTML = BUILD / "html"
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+VIEWPORT = {"width": 1280, "height": 900}
 GLUE_ROLE = re.compile(r"\{glue(?::text)?\}`([^`]+)`")
+TABLE_RULE = re.compile(r"^\s*\|?\s*:?-{3,}:?\s*(\|\s*:?-{3,}:?\s*)+\|?\s*$")
 
 
 def toc_documents() -> list[str]:
@@ -46,6 +60,9 @@ def toc_documents() -> list[str]:
     return docs
 
 
+DOCS = toc_documents()
+
+
 def expected_glue_strings(doc: str) -> list[str]:
     """The text each glue role of ``doc`` renders to, from the executed notebook."""
     from myst_nb.core.variables import format_plain_text
@@ -54,7 +71,7 @@ def expected_glue_strings(doc: str) -> list[str]:
     roles = GLUE_ROLE.findall(src)
     if not roles:
         return []
-    glued = json.loads((ROOT / "_build" / "jupyter_execute" / f"{doc}.glue.json").read_text())
+    glued = json.loads((BUILD / "jupyter_execute" / f"{doc}.glue.json").read_text())
     values = {key: out["data"]["text/plain"] for key, out in glued.items()}
     expected = []
     for role in roles:
@@ -62,6 +79,118 @@ def expected_glue_strings(doc: str) -> list[str]:
         assert key in values, f"{doc}: glue key {key!r} is used in the text but never glued"
         expected.append(format_plain_text(values[key], fmt))
     return expected
+
+
+def count_markdown_tables(text: str) -> int:
+    """Markdown tables in ``text``: delimiter rows (``|---|---|``) under a row with a pipe."""
+    lines = text.splitlines()
+    return sum(1 for i in range(1, len(lines))
+               if TABLE_RULE.match(lines[i]) and "|" in lines[i - 1])
+
+
+def prose_of(source: str) -> str:
+    """The Markdown text of a MyST notebook outside its code cells and fenced blocks."""
+    out, fence = [], None
+    for line in source.splitlines():
+        m = re.match(r"^\s*(`{3,}|~{3,})", line)
+        if fence is None and m:
+            fence = m.group(1)
+            continue
+        if fence is not None:
+            if line.strip() == fence:
+                fence = None
+            continue
+        out.append(line)
+    return "\n".join(out)
+
+
+def expected_tables(doc: str) -> int:
+    """Tables the page must show: the Markdown tables of its text and those its cells emit
+    as Markdown (``lib.book.markdown_table``), read from the executed notebook."""
+    n = count_markdown_tables(prose_of((ROOT / f"{doc}.md").read_text()))
+    nb = BUILD / "jupyter_execute" / f"{doc}.ipynb"
+    if nb.exists():
+        for cell in json.loads(nb.read_text()).get("cells", []):
+            for out in cell.get("outputs", []):
+                md = out.get("data", {}).get("text/markdown")
+                if md:
+                    n += count_markdown_tables("".join(md) if isinstance(md, list) else md)
+    return n
+
+
+# ---------------------------------------------------------------- one pass over the book
+
+READ_PAGE = r"""() => {
+  const main = document.querySelector('main') || document.body;
+  const where = (el) => {
+    let h = null, n = el;
+    for (; n && !h; n = n.parentElement) {
+      let s = n.previousElementSibling;
+      while (s && !h) {
+        h = s.matches('h1,h2,h3,h4') ? s : s.querySelector('h1,h2,h3,h4');
+        s = s.previousElementSibling;
+      }
+    }
+    return h ? h.textContent.replace(/[#¶]/g, '').trim() : '(top of page)';
+  };
+  const copy = main.cloneNode(true);
+  copy.querySelectorAll('pre, code, mjx-container, script, style, .cell_input')
+      .forEach(e => e.remove());
+  const tables = Array.from(main.querySelectorAll('table'))
+      .filter(t => !t.closest('.highlight, mjx-container'));
+  const pipeParagraphs = Array.from(main.querySelectorAll('p'))
+      .map(p => p.textContent.trim())
+      .filter(t => t.startsWith('|') && (t.includes('|---') || t.split(' | ').length > 2))
+      .map(t => t.slice(0, 100));
+  const overflowing = Array.from(main.querySelectorAll('div.cell_input pre, div.highlight pre'))
+      .filter(p => p.scrollWidth > p.clientWidth + 1)
+      .map(p => {
+        const lines = p.textContent.split('\n');
+        const longest = lines.reduce((a, b) => (b.length > a.length ? b : a), '');
+        return {section: where(p), scrollWidth: p.scrollWidth, clientWidth: p.clientWidth,
+                line: longest};
+      });
+  const images = Array.from(main.querySelectorAll('img')).map(i => ({
+      src: i.getAttribute('src'), alt: i.getAttribute('alt'), section: where(i),
+      loaded: i.complete && i.naturalWidth > 0}));
+  const legend = [];
+  main.querySelectorAll('ul').forEach(ul => {
+    const items = Array.from(ul.querySelectorAll(':scope > li'));
+    const terms = items.map(li => {
+      const s = li.querySelector('strong');
+      return s && li.textContent.trim().startsWith(s.textContent.trim()) ? s.textContent.trim() : null;
+    });
+    if (items.length && terms.every(t => t)) legend.push(...terms);
+  });
+  const statuses = [];
+  tables.forEach(t => {
+    const head = Array.from(t.querySelectorAll('thead th')).map(th => th.textContent.trim());
+    const k = head.indexOf('status');
+    if (k < 0) return;
+    t.querySelectorAll('tbody tr').forEach(tr => {
+      const cells = tr.querySelectorAll('td');
+      if (cells[k]) statuses.push({row: cells[0].textContent.trim(), status: cells[k].textContent.trim()});
+    });
+  });
+  return {
+    hasMathjax: !!(window.MathJax && MathJax.startup),
+    nMath: document.querySelectorAll('mjx-container').length,
+    prose: copy.innerText,
+    fullText: document.body.innerText,
+    nTables: tables.length,
+    pipeParagraphs, overflowing, images, legend, statuses,
+  };
+}"""
+
+
+@dataclass
+class Page:
+    """What one visit of a page found."""
+    doc: str
+    url: str
+    data: dict
+    requests: list[str] = field(default_factory=list)
+    failed: list[str] = field(default_factory=list)
 
 
 class _QuietHandler(http.server.SimpleHTTPRequestHandler):
@@ -82,63 +211,131 @@ def server(built_book):
 
 
 @pytest.fixture(scope="module")
-def browser():
+def pages(server) -> dict[str, Page]:
+    """Every page of the table of contents, read once in one headless Chromium."""
     if not Path(CHROMIUM).exists():
         pytest.skip(f"Debian's chromium is not installed ({CHROMIUM} missing): browser test skipped; "
                     "run .ci/run or `apt-get install chromium` to enable it")
     from playwright.sync_api import sync_playwright
 
+    read: dict[str, Page] = {}
+    tic = time.perf_counter()
     with sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, headless=True, args=[
+        browser = p.chromium.launch(executable_path=CHROMIUM, headless=True, args=[
             "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
             "--disable-background-networking", "--disable-component-update", "--disable-sync"])
-        yield b
-        b.close()
+        context = browser.new_context(viewport=VIEWPORT)
+        for doc in DOCS:
+            url = f"{server}/{'index' if doc == 'intro' else doc}.html"
+            page = context.new_page()
+            seen = Page(doc, url, {})
+            page.on("request", lambda r, seen=seen: seen.requests.append(r.url))
+            page.on("requestfailed", lambda r, seen=seen: seen.failed.append(r.url))
+            page.goto(url, wait_until="networkidle")
+            if page.evaluate("() => !!(window.MathJax && MathJax.startup && MathJax.startup.promise)"):
+                page.evaluate("() => MathJax.startup.promise")
+            page.wait_for_function("() => Array.from(document.images).every(i => i.complete)")
+            seen.data = page.evaluate(READ_PAGE)
+            page.close()
+            read[doc] = seen
+        context.close()
+        browser.close()
+    print(f"\nread {len(read)} pages in one browser in {time.perf_counter() - tic:.1f} s")
+    return read
 
 
-TEXT_WITHOUT_CODE = """() => {
-  const main = document.querySelector('main') || document.body;
-  const copy = main.cloneNode(true);
-  copy.querySelectorAll('pre, code, mjx-container, script, style, .cell_input').forEach(e => e.remove());
-  return copy.innerText;
-}"""
+def _page(pages: dict[str, Page], doc: str) -> Page:
+    return pages[doc]
 
 
-@pytest.mark.parametrize("doc", toc_documents())
-def test_page_reads_correctly_offline(doc, server, browser):
-    page = browser.new_page()
-    requests: list[str] = []
-    page.on("request", lambda r: requests.append(r.url))
-    failed: list[str] = []
-    page.on("requestfailed", lambda r: failed.append(r.url))
-    url = f"{server}/{'index' if doc == 'intro' else doc}.html"
-    page.goto(url, wait_until="networkidle")
-    src = (ROOT / f"{doc}.md").read_text()
+# ---------------------------------------------------------------- the checks, page by page
 
-    has_mathjax = page.evaluate("() => !!(window.MathJax && MathJax.startup && MathJax.startup.promise)")
-    if has_mathjax:
-        page.evaluate("() => MathJax.startup.promise")
-    n_math = page.locator("mjx-container").count()
+@pytest.mark.parametrize("doc", DOCS)
+def test_math_is_typeset_by_the_bundled_mathjax(doc, pages):
+    pg, src = _page(pages, doc), (ROOT / f"{doc}.md").read_text()
     if "$" in src or "{math}" in src:
-        assert has_mathjax, f"{doc}: MathJax did not load"
-        assert n_math > 0, f"{doc}: no typeset math (mjx-container) found"
-
-    text = page.evaluate(TEXT_WITHOUT_CODE)
+        assert pg.data["hasMathjax"], f"{doc}: MathJax did not load"
+        assert pg.data["nMath"] > 0, f"{doc}: no typeset math (mjx-container) found"
+    text = pg.data["prose"]
     for raw in ("$$", "\\[", "\\begin{"):
         assert raw not in text, f"{doc}: raw LaTeX {raw!r} left in the text"
     leftover = re.findall(r"\\(?:frac|varphi|omega|beta|tau|sqrt|mathbb|dot|ddot)\b", text)
     assert not leftover, f"{doc}: untypeset LaTeX commands in the text: {sorted(set(leftover))}"
 
-    page.wait_for_function("() => Array.from(document.images).every(i => i.complete)")
-    broken = page.evaluate("() => Array.from(document.images).filter(i => i.naturalWidth === 0).map(i => i.src)")
-    assert not broken, f"{doc}: images that did not load: {broken}"
 
-    outside = [u for u in requests
+@pytest.mark.parametrize("doc", DOCS)
+def test_images_load_and_no_request_leaves_loopback(doc, pages):
+    pg = _page(pages, doc)
+    broken = [f"{i['src']} (in '{i['section']}')" for i in pg.data["images"] if not i["loaded"]]
+    assert not broken, f"{doc}: images that did not load: {broken}"
+    outside = [u for u in pg.requests
                if urlparse(u).scheme not in ("data", "blob", "about") and urlparse(u).hostname != "127.0.0.1"]
     assert not outside, f"{doc}: requests left the loopback address: {outside}"
-    assert not failed, f"{doc}: requests failed: {failed}"
+    assert not pg.failed, f"{doc}: requests failed: {pg.failed}"
 
-    full_text = " ".join(page.evaluate("() => document.body.innerText").split())
-    for expected in expected_glue_strings(doc):
-        assert expected in full_text, f"{doc}: glued value {expected!r} not found in the page text"
-    page.close()
+
+@pytest.mark.parametrize("doc", DOCS)
+def test_every_glued_value_is_in_the_text(doc, pages):
+    full_text = " ".join(_page(pages, doc).data["fullText"].split())
+    missing = [e for e in expected_glue_strings(doc) if e not in full_text]
+    assert not missing, f"{doc}: glued values not found in the page text: {missing}"
+
+
+@pytest.mark.parametrize("doc", DOCS)
+def test_no_raw_glue_nan_or_none_in_the_prose(doc, pages):
+    text = _page(pages, doc).data["prose"]
+    found = []
+    # "None of ..." is English; a None or nan anywhere else is a value that went missing
+    for pattern in (r"\{glue", r"\bnan\b", r"\bNaN\b", r"\bNone\b(?! of\b)"):
+        for m in re.finditer(pattern, text):
+            found.append(f"{m.group()!r} in '…{text[max(0, m.start() - 50):m.end() + 30]}…'".replace("\n", " "))
+    assert not found, f"{doc}: raw glue or missing values in the prose:\n  " + "\n  ".join(found)
+
+
+@pytest.mark.parametrize("doc", DOCS)
+def test_markdown_tables_render_as_tables(doc, pages):
+    pg = _page(pages, doc)
+    assert not pg.data["pipeParagraphs"], (
+        f"{doc}: Markdown tables rendered as paragraphs of pipes (not <table>): {pg.data['pipeParagraphs']}")
+    expected = expected_tables(doc)
+    assert pg.data["nTables"] >= expected, (
+        f"{doc}: {pg.data['nTables']} <table> elements on the page, {expected} Markdown tables in its "
+        "source and cell outputs")
+
+
+@pytest.mark.parametrize("doc", DOCS)
+def test_code_lines_fit_their_blocks_at_1280px(doc, pages):
+    over = _page(pages, doc).data["overflowing"]
+    assert not over, f"{doc}: code blocks wider than their box at {VIEWPORT['width']} px:\n  " + "\n  ".join(
+        f"in '{o['section']}': {o['scrollWidth']} > {o['clientWidth']} px, longest line {o['line']!r}"
+        for o in over)
+
+
+ALT_PATH = re.compile(r"_build|\.(png|jpe?g|svg|gif|webp)\b|^\S*[/\\]\S*$", re.IGNORECASE)
+
+
+@pytest.mark.parametrize("doc", DOCS)
+def test_figure_alt_text_is_a_sentence(doc, pages):
+    bad = []
+    for img in _page(pages, doc).data["images"]:
+        alt = (img["alt"] or "").strip()
+        if not alt:
+            why = "no alt text"
+        elif ALT_PATH.search(alt):
+            why = "alt text is a file path"
+        elif len(alt.split()) < 4 or not alt[0].isupper() or not alt.endswith("."):
+            why = "alt text is not a sentence (capitalised, four words or more, ending with '.')"
+        else:
+            continue
+        bad.append(f"{img['src']} in '{img['section']}': {why}: {alt!r}")
+    assert not bad, f"{doc}: figures without a descriptive alt text:\n  " + "\n  ".join(bad)
+
+
+def test_report_statuses_come_from_its_legend(pages):
+    data = _page(pages, "report").data
+    legend, rows = set(data["legend"]), data["statuses"]
+    assert legend, "report: no legend of statuses (a list of **status**: meaning) found"
+    assert rows, "report: no table with a 'status' column found"
+    off = [f"row {r['row']!r}: status {r['status']!r}" for r in rows
+           if re.sub(r"\s*\(.*\)\s*$", "", r["status"]) not in legend]
+    assert not off, f"report: statuses outside its legend {sorted(legend)}:\n  " + "\n  ".join(off)
