@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: book test benchmark clean
+.PHONY: book test benchmark clean mutation
 
 $(STAMP): requirements.txt pyproject.toml
 	@echo "Installing .venv from requirements.txt and pyproject.toml (a few minutes the first time)..."
@@ -34,3 +34,9 @@ benchmark: $(STAMP)
 
 clean:
 	rm -rf _build
+
+# Mutation testing of the core modules with mutmut, by hand (not in CI): about half an hour
+# on 2 cores, niced. Appends the score and the surviving mutants to mutation/REPORT.md.
+# MODULES="angles params" limits it to some of the seven.
+mutation: $(STAMP)
+	$(BIN)/python mutation/run.py $(MODULES)
