@@ -1,6 +1,7 @@
 """The book builds from scratch, executing every notebook, with Sphinx warnings as errors;
 and its sources read at 1280 px (code lines that fit their block)."""
 
+import os
 import re
 from pathlib import Path
 
@@ -66,3 +67,39 @@ def test_shown_code_lines_fit_a_code_block_at_1280px(path):
                  for n, line in enumerate(code) if len(line) > width]
     assert not long, (f"{path.relative_to(ROOT)}: code lines wider than their block at "
                       "1280 px (break the call over lines):\n  " + "\n  ".join(long))
+
+
+def test_a_build_is_reused_only_when_current(tmp_path, monkeypatch):
+    """conftest's reuse rule: the HTML written between the start and the end of the build
+    whose log is kept, and no input of the book changed after that build began."""
+    import conftest
+
+    monkeypatch.setattr(conftest, "ROOT", tmp_path)
+    build = tmp_path / "_build"
+    (build / "html").mkdir(parents=True)
+    (tmp_path / "chapters").mkdir()
+    files = {name: tmp_path / name for name in
+             ("chapters/01.md", "_toc.yml", "README.md", "_build/build.log",
+              "_build/html/searchindex.js", "_build/build.rc")}
+    for f in files.values():
+        f.write_text("0\n")
+
+    def at(name, t):
+        os.utime(files[name], (t, t))
+
+    for name, t in (("chapters/01.md", 100), ("_toc.yml", 100), ("README.md", 100),
+                    ("_build/build.log", 200), ("_build/html/searchindex.js", 250),
+                    ("_build/build.rc", 260)):
+        at(name, t)
+    done = conftest._current_build()
+    assert done is not None and done.returncode == 0 and done.stdout == "0\n"
+    at("README.md", 300)                       # not part of the book
+    assert conftest._current_build() is not None
+    at("_toc.yml", 210)                        # an input changed during the build
+    assert conftest._current_build() is None
+    at("_toc.yml", 100)
+    at("_build/html/searchindex.js", 300)      # HTML from a later build than the log
+    assert conftest._current_build() is None
+    at("_build/html/searchindex.js", 250)
+    files["_build/build.rc"].unlink()          # the build did not finish
+    assert conftest._current_build() is None
