@@ -27,6 +27,7 @@ from .integrators.batch import dop853
 from .integrators.switched import Segments, SwitchedLoop
 from .parallel import map_in_processes
 from .params import PAPER_DZ0, PAPER_Z0, Body, Gains
+from .rotation import sampled_extremes, sampled_range
 from .trajectories import Circle, Eight, Reference
 
 __all__ = [
@@ -270,7 +271,8 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
 
 #: the options of :func:`limit_verdicts`; the thresholds mean what they mean in :mod:`lib.dynamics.verdicts`
 LIMIT_DEFAULTS = dict(transient=60, periods=120, block=12, max_period=8, candidate_tol=1e-3, newton_tol=1e-9,
-                      fd_step=1e-6, reach_tol=1e-3, approach_tol=0.05, lyapunov_band=0.01, return_tol=0.05)
+                      fd_step=1e-6, reach_tol=1e-3, approach_tol=0.05, lyapunov_band=0.01, return_tol=0.05,
+                      slip_band=1e-3)
 
 #: Newton on the switched loop's period map: the Jacobian by differences, steps cut to 0.1
 _NEWTON = dict(max_iter=9, max_step=0.1)
@@ -323,10 +325,14 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
       lost stability). An attracting one inside means a slow spiral onto it: undecided.
 
     Columns: angle_limit (rad), angle_deg, force_limit (N, inf for none), regime, period,
-    turns (of the heading per period of a slipping orbit), floquet (largest |multiplier|),
-    lyapunov and lyapunov_stderr (1/s), returns, p_range (rad) and pos_err (m, largest
-    position error) over the section, crossings, slides, t_sliding (s), reason, and orbit
-    (the located orbit's state at t = 0, [x, y, phi, xdot, ydot, phidot], or None).
+    turns (of the heading per k periods of a slipping orbit), floquet (largest |multiplier|),
+    lyapunov and lyapunov_stderr (1/s), returns; p_range (rad) and pos_err (m, largest
+    position error) over the whole orbit, or over the observed run without one, sampled
+    :data:`MEASURE_SAMPLES` times a period; drift and drift_stderr (turns of the heading per
+    period: n / k on an orbit, else measured with its batch-means error); lost (the heading
+    slips, :func:`lib.dynamics.verdicts.heading_lost`) and turns_round (p_range > 2 pi);
+    crossings, slides, t_sliding (s), reason, and orbit (the located orbit's state at t = 0,
+    [x, y, phi, xdot, ydot, phidot], or None).
 
     Returns (a DataFrame with one row per pair, the :class:`SwitchedRuns`)."""
     unknown = set(options) - set(LIMIT_DEFAULTS)
@@ -365,18 +371,57 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
     found = orb["found"]
     regime[found] = dv.orbit_regime(orb["n"][found])
     reason[found] = ""
-    rows = []
-    for q in range(N):
-        p = sec[q, :, 4]
-        rows.append(dict(angle_limit=runs.angle_limit[q], angle_deg=float(np.degrees(runs.angle_limit[q])),
-                         force_limit=runs.force_limit[q], regime=regime[q], period=int(orb["k"][q]),
-                         turns=int(orb["n"][q]), floquet=mu[q], lyapunov=lamT[q] / T, lyapunov_stderr=seT[q] / T,
-                         returns=returns[q], p_range=float(np.ptp(p)),
-                         pos_err=float(np.hypot(sec[q, :, 0], sec[q, :, 1]).max()),
-                         crossings=int(runs.crossings[q]), slides=int(runs.slides[q]),
-                         t_sliding=float(runs.t_sliding[q]), reason=reason[q],
-                         orbit=orb["x"][q].copy() if found[q] else None))
-    return pd.DataFrame(rows), runs
+    m = _over_the_run(pmap, runs.states[:, ntr], orb, npr, blk)
+    lost = dv.heading_lost(found, orb["n"], m["drift"], m["drift_stderr"], slip_band=o["slip_band"])
+    frame = pd.DataFrame(dict(
+        angle_limit=runs.angle_limit, angle_deg=np.degrees(runs.angle_limit), force_limit=runs.force_limit,
+        regime=regime, period=orb["k"], turns=orb["n"], floquet=mu, lyapunov=lamT / T, lyapunov_stderr=seT / T,
+        returns=returns, p_range=m["p_range"], pos_err=m["pos_err"], drift=m["drift"],
+        drift_stderr=m["drift_stderr"], lost=lost, turns_round=dv.turns_round(m["p_range"]),
+        crossings=runs.crossings, slides=runs.slides, t_sliding=runs.t_sliding, reason=reason,
+        orbit=[orb["x"][q].copy() if found[q] else None for q in range(N)]))
+    return frame, runs
+
+
+#: samples per reference period of the runs that measure ranges over a whole orbit or run
+MEASURE_SAMPLES = 40
+
+
+def _over_the_run(pmap: "_SwitchedMap", start, orb: dict, periods: int, block: int) -> dict:
+    """What the section alone cannot show, sampled ``MEASURE_SAMPLES`` times a period: the
+    range of p (rad) and the largest position error (m) over the whole orbit (its k periods
+    from the orbit's point) or, without one, over the observed run (``periods`` periods from
+    ``start``, the state at the end of the transient); and the heading's drift (turns per
+    period) with its batch-means standard error (blocks of ``block`` periods): n / k with no
+    error on an orbit. The runs without an orbit are integrated again from ``start`` on the
+    same step grid; for a chaotic one the samples are a second trajectory on the same attractor."""
+    N = start.shape[0]
+    out = dict(p_range=np.full(N, np.nan), pos_err=np.full(N, np.nan), drift=np.full(N, np.nan),
+               drift_stderr=np.full(N, np.nan))
+    groups = [(np.flatnonzero(~orb["found"]), periods, start)]
+    groups += [(np.flatnonzero(orb["found"] & (orb["lag"] == k)), int(k), orb["x"])
+               for k in np.unique(orb["lag"][orb["found"]])]
+    S = MEASURE_SAMPLES
+    for rows, k, x0 in groups:
+        if rows.size == 0:
+            continue
+        r = switched_runs(pmap.body, pmap.gains, pmap.ref, pmap.b[rows], pmap.f[rows], s0=x0[rows], n_periods=k,
+                          steps_per_period=pmap.steps, samples_per_period=S)
+        p = r.states[:, :, 2] - pmap.ref.z(r.t)[:, 2][None]
+        err = r.errors
+        e = np.hypot(err[..., 0], err[..., 1])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            de = np.where(e > 0, (err[..., 0] * err[..., 2] + err[..., 1] * err[..., 3]) / e, 0.0)
+        h = r.t[1] - r.t[0]
+        out["p_range"][rows] = sampled_range(p, cyclic=False, dy=err[..., 5], h=h)     # Hermite-refined extremes
+        out["pos_err"][rows] = sampled_extremes(e, cyclic=False, dy=de, h=h)[1]
+        if k == periods and not orb["found"][rows[0]]:
+            nb = periods // block
+            ends = p[:, ::S * block][:, :nb + 1]
+            out["drift"][rows], out["drift_stderr"][rows] = dv.drift_statistics(ends, block, 2 * np.pi)
+        else:
+            out["drift"][rows], out["drift_stderr"][rows] = orb["n"][rows] / orb["k"][rows], 0.0
+    return out
 
 
 #: how many times longer :func:`extend_undecided` runs the points left undecided

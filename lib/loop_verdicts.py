@@ -69,7 +69,7 @@ def _check_loop(body, gains, kind, allocation, limits) -> Limits:
 LOOP_VERDICT_DEFAULTS = MappingProxyType(dict(
     steps=128, transient=32, periods=72, block=12, max_period=8, candidate_tol=0.05, newton_tol=1e-8,
     newton_iter=6, fd_step=1e-6, reach_tol=0.05, reach_floor=1e-9, lyapunov_band=0.01, slip_band=1e-3,
-    position_band=1e-3, return_tol=0.05, d0=1e-7))
+    position_band=1e-3, position_tol=0.1, return_tol=0.05, d0=1e-7))
 
 
 class _PeriodFlow:
@@ -232,7 +232,7 @@ def _loop_options(options: dict) -> dict:
     if o["periods"] // o["block"] < 3:
         raise ValueError(f"periods ({o['periods']}) must hold at least 3 blocks of {o['block']} periods")
     for name in ("candidate_tol", "newton_tol", "fd_step", "reach_tol", "reach_floor", "lyapunov_band",
-                 "slip_band", "position_band", "return_tol", "d0"):
+                 "slip_band", "position_band", "position_tol", "return_tol", "d0"):
         v = o[name]
         if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not (np.isfinite(v) and v > 0):
             raise ValueError(f"{name} must be a positive finite number, got {v!r}")
@@ -273,18 +273,21 @@ def closed_loop_verdicts(body: Body, gains: Gains, kind: str, R, Theta, weights=
        closes on itself (:func:`lib.dynamics.verdicts.section_returns` <= ``return_tol``);
        else ``undecided`` with a reason.
 
-    ``lost`` (the heading): slipping, or no orbit and |drift of p| > 3 SE + ``slip_band``
-    (1e-3 turns per period) or a range of p above 2 pi over the observed periods.
-    ``position_lost``: no orbit and either the mean position error grows by more than 3 SE +
-    ``position_band`` (1e-3 m per period) or, over the last block, the body is farther from its
-    reference point than the radius R of the path itself (the analogue of the heading's full
-    turn); or the state became non-finite.
+    ``lost`` (the heading, :func:`lib.dynamics.verdicts.heading_lost`): slipping, or no orbit
+    and |drift of p| > 3 SE + ``slip_band`` (1e-3 turns per period); ``turns_round`` the other
+    reading (range of p above 2 pi: over the last block on an orbit, over the observed periods
+    otherwise). ``position_lost``: no orbit and either the mean position error grows by more
+    than 3 SE + ``position_band`` (1e-3 m per period) or, over the last block, the body is
+    farther from its reference point than the radius R of the path itself; or the state became
+    non-finite. ``tracked``: the position is not lost and its largest error over the last block
+    is at most ``position_tol`` R (0.1 R: the body stays on the path it is asked to follow).
 
     Returns a DataFrame, one row per point: R, Theta, w_phi, regime, period, floquet (largest
     multiplier modulus), lyapunov, lyapunov_stderr (1/s; for an orbit ln|mu_1| / (k T)),
     slip, slip_stderr (turns per period), lost, pos_drift, pos_drift_stderr (m per period),
-    position_lost, residual, distance, p_range (rad, over the last block), p_rms (rad, RMS of
-    p wrapped to (-pi, pi], last block), pos_rms, pos_max (m, last block), periods, reason.
+    position_lost, tracked, residual, distance, turns_round, p_range (rad, over the last block),
+    p_rms (rad, RMS of p wrapped to (-pi, pi], last block), pos_rms, pos_max (m, last block),
+    periods, reason.
     """
     kinds = np.atleast_1d(np.asarray(kind, dtype=object))
     if kinds.ndim != 1 or kinds.size == 0:
@@ -372,6 +375,13 @@ def _accumulate(acc: dict, zd, Y, b: int, last: bool) -> None:
         acc["posmax"] = np.fmax(acc["posmax"], e)
 
 
+def _rows(good, found, N: int) -> np.ndarray:
+    """(N,) bool: the rows ``good[found]``."""
+    m = np.zeros(N, bool)
+    m[good[found]] = True
+    return m
+
+
 def _decide(flow: _PeriodFlow, obs: dict, turns, o) -> dict:
     """The verdict columns from an observed run, by :mod:`lib.dynamics.verdicts`: the orbit
     reached (Newton with a difference Jacobian), else the rule on the exponent; the heading's
@@ -408,12 +418,14 @@ def _decide(flow: _PeriodFlow, obs: dict, turns, o) -> dict:
     out["regime"][rest], out["reason"][rest] = regime[rest], reason[rest]
     out["lyapunov"][rest], out["lyapunov_stderr"][rest] = lam[rest] / T[rest], se[rest] / T[rest]
     out["slip"][rest], out["slip_stderr"][rest] = drift[rest], dse[rest]
-    out["lost"][rest] = dv.heading_lost(False, 0, drift, dse, acc["pmax"] - acc["pmin"],
-                                        slip_band=o["slip_band"])[rest]
+    out["lost"][rest] = dv.heading_lost(False, 0, drift, dse, slip_band=o["slip_band"])[rest]
+    run_range = acc["pmax"] - acc["pmin"]
+    out["turns_round"] = dv.turns_round(np.where(_rows(good, f, N), acc["lmax"] - acc["lmin"], run_range))
     out["position_lost"][rest] = ((pdrift > 3 * pse + o["position_band"]) | (acc["posmax"] > flow.R))[rest]
     bad = ~finite
     out["reason"][bad] = "the state became non-finite (the run diverged)"
     out["lost"][bad] = out["position_lost"][bad] = True
+    out["tracked"] = ~out["position_lost"] & (acc["posmax"] <= o["position_tol"] * flow.R)
     return out
 
 
@@ -448,8 +460,9 @@ def verdict_runs(body: Body, gains: Gains, runs: dict, **options) -> dict:
 
 
 def held(frame: pd.DataFrame) -> np.ndarray:
-    """(N,) bool: the closed loop reaches an attracting periodic orbit (verdict ``periodic``) and
-    neither the heading nor the position is lost, by :func:`closed_loop_verdicts`."""
-    return ((frame.regime == "periodic") & ~frame.lost & ~frame.position_lost).to_numpy()
+    """(N,) bool, the book's one definition of "held" (:func:`lib.dynamics.verdicts.held`):
+    the closed loop reaches an attracting periodic orbit (verdict ``periodic``), the heading is
+    not lost, and the position is tracked (column ``tracked`` of :func:`closed_loop_verdicts`)."""
+    return dv.held(frame.regime.to_numpy(), frame.lost.to_numpy(), frame.tracked.to_numpy())
 
 

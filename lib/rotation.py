@@ -28,7 +28,7 @@ from .rotation_field import coefficients, rotation_rates, rotation_rates_dphi
 from .trajectories import KINEMATICS, POSITIONS
 
 __all__ = [
-    "steps_per_period", "reduced_rotation", "classify_samples", "sampled_range", "rotation_sweep",
+    "steps_per_period", "reduced_rotation", "classify_samples", "sampled_range", "sampled_extremes", "rotation_sweep",
     "ENGINES", "rotation_period_map", "rotation_orbit", "RotationLyapunov",
     "rotation_lyapunov", "WINDING",
 ]
@@ -204,7 +204,14 @@ def classify_samples(P: np.ndarray, tol: float = 1e-9, dP: np.ndarray | None = N
 
 
 def sampled_range(y, cyclic=True, dy=None, h: float = 1.0) -> np.ndarray:
-    """max - min of each row of ``y`` (samples at equal phase steps ``h``).
+    """max - min of each row of ``y`` (samples at equal phase steps ``h``), the extremes
+    refined as :func:`sampled_extremes` refines them."""
+    lo, hi = sampled_extremes(y, cyclic, dy, h)
+    return hi - lo
+
+
+def sampled_extremes(y, cyclic=True, dy=None, h: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """(min, max) of each row of ``y`` (samples at equal phase steps ``h``).
 
     Without ``dy`` the extreme samples are refined by the parabola through them
     and their neighbours (error O(h^3)); with the derivatives ``dy`` (per unit
@@ -216,7 +223,7 @@ def sampled_range(y, cyclic=True, dy=None, h: float = 1.0) -> np.ndarray:
     y = np.atleast_2d(np.asarray(y, dtype=float))
     n = y.shape[1]
     if n < 3:
-        return y.max(axis=1) - y.min(axis=1)
+        return y.min(axis=1), y.max(axis=1)
     cyclic = np.broadcast_to(np.asarray(cyclic, bool), y.shape[:1])
     rows = np.arange(y.shape[0])
 
@@ -248,9 +255,9 @@ def sampled_range(y, cyclic=True, dy=None, h: float = 1.0) -> np.ndarray:
         return best * sign
 
     if dy is None:
-        return parabola(y.argmax(axis=1), 1) - parabola(y.argmin(axis=1), -1)
+        return parabola(y.argmin(axis=1), -1), parabola(y.argmax(axis=1), 1)
     dy = np.atleast_2d(np.asarray(dy, dtype=float))
-    return hermite(y.argmax(axis=1), 1) - hermite(y.argmin(axis=1), -1)
+    return hermite(y.argmin(axis=1), -1), hermite(y.argmax(axis=1), 1)
 
 
 def rotation_sweep(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, tol: float = 1e-9,

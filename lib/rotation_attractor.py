@@ -126,11 +126,12 @@ class MapSummary:
     """What a map of verdicts (:func:`rotation_verdicts`) shows, for the book to quote.
 
     Counts: ``n_grid`` points; ``n_periodic``, ``n_slipping``, ``n_chaotic``,
-    ``n_quasiperiodic``, ``n_undecided`` per regime; ``n_lost`` where stability is lost
-    (column ``lost``), of them ``n_lost_slipping`` on a slipping orbit and
-    ``n_lost_no_orbit`` without an orbit (drifting, or turning by more than a full turn);
-    ``n_chaotic_within_turn`` chaotic points whose heading stays within one turn (not
-    lost), ``chaotic_range_median`` (rad) the median range of the chaotic points;
+    ``n_quasiperiodic``, ``n_undecided`` per regime; ``n_lost`` where the heading is lost
+    (column ``lost``: it slips), of them ``n_lost_slipping`` on a slipping orbit and
+    ``n_lost_no_orbit`` without an orbit (drifting); ``n_turns_round`` the count under the
+    other reading (column ``turns_round``: the range of p exceeds a full turn), of them
+    ``n_turns_round_periodic`` on periodic orbits and ``n_turns_round_chaotic`` chaotic;
+    ``n_chaotic_within_turn`` chaotic points whose heading stays within one turn, ``chaotic_range_median`` (rad) the median range of the chaotic points;
     ``n_period_gt1`` orbits longer than one
     reference period, ``max_period`` the longest. Ranges (rad) over the periodic orbits:
     ``range_min``, ``range_max``. ``theta_min_lost``, ``theta_min_chaotic`` (rad/s): the
@@ -151,6 +152,9 @@ class MapSummary:
     n_lost: int
     n_lost_slipping: int
     n_lost_no_orbit: int
+    n_turns_round: int
+    n_turns_round_periodic: int
+    n_turns_round_chaotic: int
     n_chaotic_within_turn: int
     chaotic_range_median: float
     n_period_gt1: int
@@ -172,7 +176,8 @@ class MapSummary:
 def map_summary(frame: pd.DataFrame) -> MapSummary:
     """The :class:`MapSummary` of a frame returned by :func:`rotation_verdicts` (or
     :func:`eight_rotation_sweep`)."""
-    need = {"regime", "period", "range", "floquet", "lyapunov", "lyapunov_stderr", "lost", "Theta", "periods"}
+    need = {"regime", "period", "range", "floquet", "lyapunov", "lyapunov_stderr", "lost", "turns_round", "Theta",
+            "periods"}
     if not isinstance(frame, pd.DataFrame) or not need <= set(frame.columns):
         raise ValueError(f"frame must be a DataFrame of rotation_verdicts with columns {sorted(need)}")
     if len(frame) == 0:
@@ -192,7 +197,10 @@ def map_summary(frame: pd.DataFrame) -> MapSummary:
         n_grid=len(frame), **{f"n_{r}": int((reg == r).sum()) for r in REGIMES},
         n_lost=int(frame.lost.sum()), n_lost_slipping=int((frame.lost & (reg == "slipping")).sum()),
         n_lost_no_orbit=int((frame.lost & (reg != "slipping")).sum()),
-        n_chaotic_within_turn=int((~cha.lost).sum()),
+        n_turns_round=int(frame.turns_round.sum()),
+        n_turns_round_periodic=int((frame.turns_round & (reg == "periodic")).sum()),
+        n_turns_round_chaotic=int((frame.turns_round & (reg == "chaotic")).sum()),
+        n_chaotic_within_turn=int((~cha.turns_round).sum()),
         chaotic_range_median=float(cha["range"].median()) if len(cha) else nan, n_period_gt1=int((orb.period > 1).sum()),
         max_period=int(orb.period.max()) if len(orb) else 0,
         range_min=lo(per["range"]), range_max=hi(per["range"]),

@@ -153,13 +153,13 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
     floquet (largest multiplier modulus); lyapunov, lyapunov_stderr (1/s; for an orbit
     ln|mu_1| / (k T) with no error); slip, slip_stderr (turns of p per period: n / k on
     an orbit, the measured drift over the Lyapunov run with its batch-means error
-    otherwise); lost (bool): the heading slips whole turns against the reference: the
-    verdict is ``slipping``, or no attracting orbit is reached and either the drift
-    differs from zero by more than 3 standard errors plus ``slip_band`` (1e-3 turns per
-    period) or the heading error ranges over more than a full turn (range > 2 pi) in the
-    Lyapunov run; a periodic orbit is never lost, whatever its range (it repeats), nor is
-    a motion without an orbit that stays within one turn; orbit_p (rad, p at s = 0 mod 2 pi at the orbit point the run
-    is nearest to: which orbit is reached), distance (rad, from the run's last state to
+    otherwise); lost (bool, :func:`lib.dynamics.verdicts.heading_lost`): the heading slips
+    whole turns against the reference: the verdict is ``slipping``, or no attracting orbit is
+    reached and the drift differs from zero by more than 3 standard errors plus
+    ``slip_band`` (1e-3 turns per period); turns_round (bool,
+    :func:`lib.dynamics.verdicts.turns_round`): the other reading, range > 2 pi, whether or
+    not the heading comes back; orbit_p (rad, p at s = 0 mod 2 pi at the orbit point the
+    run is nearest to: which orbit is reached), distance (rad, from the run's last state to
     that point), residual (rad, Newton's), mirror (rad, on the eight: the distance from
     the orbit to its mirror image, 0 for a symmetric orbit; a positive one coexists with
     its mirror image, a second attractor), periods (integrated), steps (per period of the fine map), verdict_steps (of the verdict map),
@@ -182,6 +182,7 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
     n_pts, n_fine = _step_counts(body, kind, R, Theta, h_lambda, steps, opts)
     res = _verdict_core(body, kind, R, Theta, p0, v0, n_pts, opts, engine, n_fine)
     cols = {k: v for k, v in res.items() if k not in ("x", "mult", "slip_n")}
+    cols["turns_round"] = dv.turns_round(res["range"])
     frame = pd.DataFrame({"R": R, "Theta": Theta, **cols, "steps": n_fine, "verdict_steps": n_pts})
     return frame
 
@@ -322,7 +323,7 @@ class _Batch:
         drift, dse = dv.drift_statistics(ly["pb"][done, :nb + 1], o["block"], 2 * np.pi)
         out["slip"][g], out["slip_stderr"][g] = drift, dse
         out["range"][g] = ly["hi"][done] - ly["lo"][done]
-        out["lost"][g] = dv.heading_lost(False, 0, drift, dse, out["range"][g], slip_band=o["slip_band"])
+        out["lost"][g] = dv.heading_lost(False, 0, drift, dse, slip_band=o["slip_band"])
         out["periods"][g] = self.t
         self.keep(~done)
 

@@ -99,6 +99,7 @@ def test_stability_boundary_reads_the_first_change_of_verdict():
 
     f = pd.DataFrame({"regime": ["periodic", "periodic", "chaotic", "periodic"], "lost": [False] * 4,
                       "position_lost": [False, False, True, False]})
+    f["tracked"] = ~f.position_lost
     b = weighting.stability_boundary([0.0, 0.1, 0.2, 0.4], f)
     assert (b["last_held"], b["first_lost"], b["changes"]) == (0.1, 0.2, 2)
     assert b["verdict"] == "chaotic, position lost" and b["ratio"] == pytest.approx(2.0)

@@ -138,15 +138,18 @@ def test_sweep_columns_and_the_lost_definition(perturb):
     Th = np.array([math.pi / 4, 0.8, 1.0, 0.8, 0.372222])
     df = verdicts.eight_rotation_sweep(BODY, R, Th, p0=perturb(np.zeros(5)))
     for col in ("R", "Theta", "regime", "period", "range", "floquet", "lyapunov", "lyapunov_stderr", "slip",
-                "lost", "steps", "residual", "periods", "reason", "mirror"):
+                "lost", "turns_round", "steps", "residual", "periods", "reason", "mirror"):
         assert col in df
     np.testing.assert_array_equal(df.R, R)
     assert list(df.regime) == ["periodic", "chaotic", "slipping", "periodic", "periodic"]
     assert set(df.regime) <= set(verdicts.REGIMES)
     orbit = df.regime.isin(["periodic", "slipping"])
-    unbounded = ~orbit & ((df.slip.abs() > 3 * df.slip_stderr + 1e-3) | (df["range"] > 2 * np.pi))
-    np.testing.assert_array_equal(df.lost, (df.regime == "slipping") | unbounded)
-    assert df.lost.tolist() == [False, True, True, False, False]   # the chaotic point turns round: lost
+    drifting = ~orbit & (df.slip.abs() > 3 * df.slip_stderr + 1e-3)
+    np.testing.assert_array_equal(df.lost, (df.regime == "slipping") | drifting)
+    np.testing.assert_array_equal(df.turns_round, df["range"] > 2 * np.pi)
+    # the chaotic point turns right round without a net drift: not lost, but it turns round
+    assert df.lost.tolist() == [False, False, True, False, False]
+    assert df.turns_round.tolist()[:3] == [False, True, True]
     assert (df.floquet[orbit] < 1).all() and (df.residual[orbit] <= 1e-10).all()
 
 
@@ -228,16 +231,18 @@ def test_map_summary_counts_what_the_frame_holds():
     frame = pd.DataFrame({
         "Theta": [0.1, 0.2, 0.3, 0.4, 0.5, 0.6],
         "regime": ["periodic", "periodic", "slipping", "chaotic", "chaotic", "undecided"],
-        "period": [1, 3, 2, 0, 0, 0], "range": [0.5, 2.0, 9.0, 3.0, 4.0, 1.0],
+        "period": [1, 3, 2, 0, 0, 0], "range": [0.5, 7.0, 9.0, 3.0, 8.0, 1.0],
         "floquet": [0.95, 0.2, 0.5, np.nan, np.nan, np.nan],
         "lyapunov": [-0.01, -0.3, -0.1, 0.2, 0.4, 0.0], "lyapunov_stderr": [0, 0, 0, 0.02, 0.1, 0.1],
         "lost": [False, False, True, True, False, False], "periods": [8, 16, 24, 120, 120, 348]})
+    frame["turns_round"] = frame["range"] > 2 * np.pi
     s = attractor.map_summary(frame)
     assert (s.n_grid, s.n_periodic, s.n_slipping, s.n_chaotic, s.n_quasiperiodic, s.n_undecided) == (6, 2, 1, 2, 0, 1)
     assert (s.n_lost, s.n_lost_slipping, s.n_lost_no_orbit, s.n_chaotic_within_turn) == (2, 1, 1, 1)
-    assert s.chaotic_range_median == 3.5
+    assert (s.n_turns_round, s.n_turns_round_periodic, s.n_turns_round_chaotic) == (3, 1, 1)
+    assert s.chaotic_range_median == 5.5
     assert (s.n_period_gt1, s.max_period, s.n_slow) == (2, 3, 1)
-    assert (s.range_min, s.range_max, s.theta_min_lost, s.theta_min_chaotic) == (0.5, 2.0, 0.3, 0.4)
+    assert (s.range_min, s.range_max, s.theta_min_lost, s.theta_min_chaotic) == (0.5, 7.0, 0.3, 0.4)
     assert (s.lyapunov_min, s.lyapunov_max, s.lyapunov_sigmas_min, s.floquet_max) == (0.2, 0.4, 4.0, 0.95)
     with pytest.raises(ValueError, match="columns"):
         attractor.map_summary(frame.drop(columns="lost"))

@@ -62,13 +62,19 @@ def test_a_contracting_run_without_an_orbit_is_undecided_and_says_so():
                                              (-0.5, 0.01, True)])
 def test_heading_lost_when_it_drifts_by_more_than_three_errors_plus_the_band(drift, se, lost):
     # no orbit, range within a turn: lost iff |drift| > 3 SE + slip_band (1e-3 turns per period)
-    got = dv.heading_lost([False], [0], [drift], [se], [1.0], slip_band=1e-3)
+    got = dv.heading_lost([False], [0], [drift], [se], slip_band=1e-3)
     assert bool(got[0]) is lost
 
 
 def test_heading_lost_on_an_orbit_exactly_when_it_slips():
-    got = dv.heading_lost([True, True], [0, -1], [np.nan, np.nan], [np.nan, np.nan], [30.0, 1.0], slip_band=1e-3)
+    got = dv.heading_lost([True, True], [0, -1], [np.nan, np.nan], [np.nan, np.nan], slip_band=1e-3)
     assert got.tolist() == [False, True]
+
+
+def test_a_swing_over_a_turn_that_comes_back_is_not_lost_but_turns_round():
+    # no drift, a range of 3 pi: held by the one definition, counted by the other reading
+    assert not dv.heading_lost([False], [0], [0.0], [1e-4], slip_band=1e-3)[0]
+    assert dv.turns_round([3 * np.pi, 6.28]).tolist() == [True, False]
 
 
 def test_every_flow_names_the_regimes_of_the_one_procedure():

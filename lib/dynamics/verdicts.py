@@ -27,7 +27,11 @@ The words (the book's definition ``def-verdicts``, Chapter 5):
 ``lost`` (the heading)
     the heading slips: a slipping orbit, or, without an orbit, a net drift of the
     heading of more than 3 standard errors plus ``slip_band`` turns per period
-    (:func:`heading_lost`).
+    (:func:`heading_lost`). A range over a full turn is reported beside it, not in it
+    (:func:`turns_round`).
+``held``
+    periodic, the heading not lost, and the position tracked where there is one
+    (:func:`held`).
 
 The steps: :func:`lag_candidates` (where the section nearly repeats),
 :func:`newton` (exact Jacobian or :func:`difference_jacobian`), Floquet multipliers
@@ -48,7 +52,7 @@ from .orbits import NewtonResult, floquet_multipliers, newton
 
 __all__ = ["REGIMES", "SIGMAS", "PeriodMap", "lag_candidates", "difference_jacobian", "newton", "NewtonResult", "least_period",
            "distance_to_orbit", "reached", "block_statistics", "batch_means", "drift_statistics", "section_returns", "classify",
-           "heading_lost", "orbit_regime", "orbit_points", "find_orbits", "enclosed_orbit"]
+           "heading_lost", "turns_round", "held", "orbit_regime", "orbit_points", "find_orbits", "enclosed_orbit"]
 
 #: the verdicts, in the order the book lists them
 REGIMES = ("periodic", "slipping", "chaotic", "quasiperiodic", "undecided")
@@ -231,6 +235,13 @@ def classify(lam_T, se_T, returns, *, band: float, return_tol: float, max_period
     return regime, reason
 
 
+def held(regime, lost, tracked=True) -> np.ndarray:
+    """The book's one definition of "held": the run reaches an attracting ``periodic`` orbit,
+    its heading is not ``lost``, and, where the flow tracks a position, the position is
+    ``tracked`` (within the flow's stated tolerance). Returns (N,) bool."""
+    return (np.asarray(regime) == "periodic") & ~np.asarray(lost, dtype=bool) & np.asarray(tracked, dtype=bool)
+
+
 def orbit_points(pmap: PeriodMap, idx, x, k) -> np.ndarray:
     """P^j(x) for j = 1, ..., K = max k (K, M, d), NaN past each row's own k."""
     k = np.broadcast_to(np.asarray(k, dtype=int), (len(idx),))
@@ -324,14 +335,23 @@ def orbit_regime(turns) -> np.ndarray:
     return np.where(np.asarray(turns) == 0, "periodic", "slipping").astype(object)
 
 
-def heading_lost(orbit, turns, drift, drift_se, p_range, *, slip_band: float) -> np.ndarray:
-    """Whether the heading is lost: on an orbit (``orbit`` (N,) bool) when it slips
-    (``turns`` != 0); without one when its drift (turns per period) differs from zero by
-    more than 3 standard errors plus ``slip_band``, or its range ``p_range`` (rad) over
-    the observed periods exceeds a full turn. Returns (N,) bool."""
+def heading_lost(orbit, turns, drift, drift_se, *, slip_band: float) -> np.ndarray:
+    """Whether the heading is lost (the book's one definition: it *slips*, gaining or losing
+    whole turns against the reference): on an orbit (``orbit`` (N,) bool) when the orbit
+    slips (``turns`` != 0 per k periods); without one when the heading's net drift (turns per
+    period) differs from zero by more than 3 standard errors plus ``slip_band``. A heading
+    that swings over more than a turn and comes back is not lost by this definition
+    (:func:`turns_round` counts it). Returns (N,) bool."""
     orbit = np.asarray(orbit, dtype=bool)
-    drifting = np.abs(drift) > SIGMAS * np.asarray(drift_se) + slip_band
-    return np.where(orbit, np.asarray(turns) != 0, drifting | (np.asarray(p_range) > TWO_PI))
+    drifting = np.abs(np.asarray(drift, dtype=float)) > SIGMAS * np.asarray(drift_se, dtype=float) + slip_band
+    return np.where(orbit, np.asarray(turns) != 0, drifting)
+
+
+def turns_round(p_range) -> np.ndarray:
+    """The other reading of "lost", reported beside it: the heading error ranges over more
+    than a full turn (``p_range`` > 2 pi rad), over the orbit or the observed run, whether
+    or not it comes back. Returns (N,) bool."""
+    return np.asarray(p_range, dtype=float) > TWO_PI
 
 
 def enclosed_orbit(step: Callable, idx, sec, *, turn_axis: int, newton_tol: float, newton_options: dict):
