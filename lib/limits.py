@@ -369,6 +369,7 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
     tried = ~orb["found"] & (orb["status"] != "") & (regime == "undecided")
     reason[tried] = [f"{_STATUS[s]}; {r}" for s, r in zip(orb["status"][tried], reason[tried])]
     found = orb["found"]
+    mu[found] = orb["rho"][found]
     regime[found] = dv.orbit_regime(orb["n"][found])
     reason[found] = ""
     m = _over_the_run(pmap, runs.states[:, ntr], orb, npr, blk)

@@ -400,10 +400,10 @@ def _decide(flow: _PeriodFlow, obs: dict, turns, o) -> dict:
                          newton_options=dict(max_iter=o["newton_iter"], stall_after=2), turns=turns[good])
     f = orb["found"]
     g, k, nn = good[f], orb["k"][f], orb["n"][f]
-    rho = np.abs(orb["mult"][f, 0])
+    rho = orb["rho"][f]
     out["regime"][g], out["period"][g] = dv.orbit_regime(nn), k
     out["slip"][g], out["slip_stderr"][g], out["lost"][g] = nn / k, 0.0, nn != 0
-    out["floquet"][g], out["lyapunov"][g] = rho, np.log(rho) / (orb["lag"][f] * T[g])
+    out["floquet"][g], out["lyapunov"][g] = rho, np.log(rho) / (k * T[g])
     out["residual"][g], out["distance"][g] = orb["residual"][f], orb["distance"][f]
 
     lam, se = dv.block_statistics(logs, Bk)

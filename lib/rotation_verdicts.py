@@ -271,9 +271,9 @@ class _Batch:
         out["regime"][g], out["period"][g], out["slip_n"][g] = dv.orbit_regime(nn), k, nn
         out["slip"][g], out["slip_stderr"][g], out["lost"][g] = nn / k, 0.0, nn != 0
         out["x"][g], out["mult"][g] = r["x"][f], r["mult"][f]
-        mod = np.abs(r["mult"][f, 0])
+        mod = r["rho"][f]
         out["floquet"][g] = mod
-        out["lyapunov"][g] = np.log(mod) * self.Theta[g] / (2 * np.pi * r["lag"][f])
+        out["lyapunov"][g] = np.log(mod) * self.Theta[g] / (2 * np.pi * k)
         out["orbit_p"][g] = wrap_angle(r["near"][f, 0] - self.eng.H0)
         out["distance"][g], out["residual"][g], out["periods"][g] = r["distance"][f], r["residual"][f], self.t
         m = np.ones(self.n, bool)

@@ -28,7 +28,7 @@ from .params import Body, Gains
 from .trajectories import KINEMATICS
 
 __all__ = ["BatchResult", "closed_loop_batch", "steady_metrics", "LOOP_VERDICT_DEFAULTS", "closed_loop_verdicts",
-           "verdict_runs", "held", "stability_boundary", "refine_boundary", "MapComparison", "compare_on_map",
+           "verdict_runs", "held", "stability_boundary", "refine_boundary", "extend_undecided", "MapComparison", "compare_on_map",
            "limits_comparison"]
 
 
@@ -144,7 +144,7 @@ def stability_boundary(w_phi, frame: pd.DataFrame) -> dict:
     largest weight before the first change), ``first_lost`` (the weight at it; NaN if every
     weight holds), ``ratio`` (their quotient, the resolution of the grid there), ``changes``
     (how often the verdict flips along the grid: more than 1 means it is not monotone), and
-    ``verdict`` (regime, and "position lost" where it is) at ``first_lost``."""
+    ``verdict`` (regime, and "position not tracked" or "heading lost" where so) at ``first_lost``."""
     w = np.asarray(w_phi, dtype=float)
     if w.ndim != 1 or w.size != len(frame) or w.size < 2 or np.any(np.diff(w) <= 0):
         raise ValueError("w_phi must be an increasing 1-D array with one weight per row of frame")
@@ -156,7 +156,7 @@ def stability_boundary(w_phi, frame: pd.DataFrame) -> dict:
         return dict(last_held=float(w[-1]), first_lost=np.nan, ratio=np.nan, changes=0, verdict="held")
     i = int(bad[0])
     r = frame.iloc[i]
-    verdict = r.regime + (", position lost" if r.position_lost else "") + (", heading lost" if r.lost else "")
+    verdict = r.regime + (", position not tracked" if not r.tracked else "") + (", heading lost" if r.lost else "")
     return dict(last_held=float(w[i - 1]), first_lost=float(w[i]), ratio=float(w[i] / w[i - 1]) if w[i - 1] > 0
                 else np.inf, changes=int(np.count_nonzero(np.diff(h.astype(int)))), verdict=verdict)
 
@@ -172,34 +172,49 @@ class MapComparison:
 
     @property
     def lost(self) -> np.ndarray:
-        """(N,) bool: the heading is lost under the paper's law (slips, or no orbit and it
-        drifts or turns right round), Chapter 5's reading."""
+        """(N,) bool: the heading is lost (it slips) under the paper's law."""
         return self.paper.lost.to_numpy()
 
     @property
+    def paper_held(self) -> np.ndarray:
+        """(N,) bool: the paper's law holds the loop (:func:`held`)."""
+        return held(self.paper)
+
+    @property
     def held(self) -> np.ndarray:
-        """(N,) bool: the weighted law reaches a periodic orbit with heading and position held."""
+        """(N,) bool: the weighted law holds the loop (:func:`held`)."""
         return held(self.weighted)
 
     @property
     def counts(self) -> pd.DataFrame:
-        """Points per regime, heading lost and position lost, for each law (columns)."""
+        """Points per regime, then heading lost (it slips), turns round (the other reading),
+        position not tracked, and held (:func:`held`), for each law (columns)."""
         rows = {}
-        for law, f in (("paper", self.paper), ("weighted", self.weighted)):
+        for law, f in (("paper's law", self.paper), ("weighted law", self.weighted)):
             c = {r: int((f.regime == r).sum()) for r in REGIMES}
-            c.update({"heading lost": int(f.lost.sum()), "position lost": int(f.position_lost.sum()),
-                      "held": int(held(f).sum())})
+            c.update({"heading lost": int(f.lost.sum()), "turns round": int(f.turns_round.sum()),
+                      "position not tracked": int((~f.tracked).sum()), "held": int(held(f).sum())})
             rows[law] = c
         return pd.DataFrame(rows)
 
+    @staticmethod
+    def _why(f: pd.DataFrame) -> np.ndarray:
+        """Why a law does not hold a point, one reason each, in this order: the position is not
+        tracked; the heading is lost; the loop is not periodic; else held."""
+        return np.where(~f.tracked, "position not tracked", np.where(
+            f.lost, "heading lost", np.where(f.regime != "periodic", "not periodic", "held")))
+
     @property
     def cross(self) -> pd.DataFrame:
-        """Points by the paper's law (rows: heading held / lost) against the weighted law
-        (columns: neither lost, heading lost (body on the path), position lost)."""
-        wl = np.where(self.weighted.position_lost, "position lost",
-                      np.where(self.weighted.lost, "heading lost", "neither lost"))
-        pl = np.where(self.lost, "lost", "held")
-        return pd.crosstab(pd.Series(pl, name="paper's law"), pd.Series(wl, name="weighted law"))
+        """Points by the paper's law (rows: held / not held) against the weighted law (columns:
+        held, or the first reason it is not: position not tracked, heading lost, not periodic),
+        with totals; the "held" row and column total the counts' "held"."""
+        pl = pd.Series(np.where(self.paper_held, "held", "not held"), name="paper's law")
+        wl = pd.Series(self._why(self.weighted), name="weighted law")
+        x = pd.crosstab(pl, wl, margins=True, margins_name="total")
+        return x.reindex(index=["held", "not held", "total"],
+                         columns=["held", "position not tracked", "heading lost", "not periodic", "total"],
+                         fill_value=0)
 
 
 def compare_on_map(body: Body, gains: Gains, R, Theta, w_phi: float, **options) -> MapComparison:
@@ -236,6 +251,35 @@ def limits_comparison(body: Body, gains: Gains, kind: str, R: float, Theta: floa
             m = steady_metrics(res, n_periods=1.0).iloc[0].to_dict()
             rows.append({"limits": name, "law": "projection" if law == "least_squares" else "exact", **m})
     return pd.DataFrame(rows)
+
+
+def extend_undecided(body: Body, gains: Gains, run: dict, frame: pd.DataFrame, factor: int = 2,
+                     **options) -> pd.DataFrame:
+    """Decide the undecided rows of ``frame`` (one row per point of ``run``, the dict given to
+    :func:`verdict_runs`: kind, R, Theta, weights, z0, dz0) again over ``factor`` times as many
+    observed periods (and blocks as long): a slowly attracting orbit (|mu| near 1) that the run
+    had not yet come within the reach tolerance of is then reached. Returns a copy of ``frame``
+    with those rows replaced and a column ``horizon`` (observed periods)."""
+    if isinstance(factor, bool) or not isinstance(factor, (int, np.integer)) or factor < 2:
+        raise ValueError(f"factor must be an integer >= 2, got {factor!r}")
+    o = {**LOOP_VERDICT_DEFAULTS, **options}
+    out = frame.copy()
+    out["horizon"] = o["periods"]
+    todo = np.flatnonzero((frame.regime == "undecided").to_numpy())
+    if todo.size == 0:
+        return out
+    n = len(frame)
+    sub = {}
+    for key, v in run.items():
+        a = np.asarray(v, dtype=object if key == "kind" else float)
+        sub[key] = a[todo] if a.ndim >= 1 and a.shape[0] == n and key != "kind" and not (
+            key in ("z0", "dz0") and a.shape == (3,)) else v
+    longer = {**options, "periods": o["periods"] * factor, "block": o["block"] * factor}
+    redo = verdict_runs(body, gains, {"redo": sub}, **longer)["redo"]
+    redo["horizon"] = longer["periods"]
+    redo.index = frame.index[todo]
+    out.loc[redo.index, redo.columns] = redo
+    return out
 
 
 def refine_boundary(body: Body, gains: Gains, run: dict, w_phi, frame: pd.DataFrame, n: int = 7,

@@ -85,8 +85,13 @@ def test_map_comparison_classifies_both_laws_by_one_verdict():
     cmp = weighting.compare_on_map(Body(), Gains(), R, Th, 0.1)
     assert cmp.paper.w_phi.tolist() == [0.0, 0.0] and cmp.weighted.w_phi.tolist() == [0.1, 0.1]
     assert cmp.paper.regime.tolist() == ["periodic", "slipping"] and cmp.lost.tolist() == [False, True]
-    assert cmp.counts.loc["heading lost", "paper"] == 1 and cmp.counts["paper"].loc[list(weighting.REGIMES)].sum() == 2
-    assert cmp.cross.to_numpy().sum() == 2
+    c = cmp.counts
+    assert c.loc["heading lost", "paper's law"] == 1 and c["paper's law"].loc[list(weighting.REGIMES)].sum() == 2
+    # the cross-table's totals are the counts' "held": one definition behind both
+    x = cmp.cross
+    assert x.loc["total", "total"] == 2
+    assert x.loc["held", "total"] == c.loc["held", "paper's law"] == cmp.paper_held.sum() == 1
+    assert x.loc["total", "held"] == c.loc["held", "weighted law"] == cmp.held.sum()
     assert cmp.held[0] and cmp.weighted.pos_rms.iloc[0] < 0.05
     with pytest.raises(ValueError, match="R"):
         weighting.compare_on_map(Body(), Gains(), [-1.0], [0.3], 0.1)
@@ -102,7 +107,7 @@ def test_stability_boundary_reads_the_first_change_of_verdict():
     f["tracked"] = ~f.position_lost
     b = weighting.stability_boundary([0.0, 0.1, 0.2, 0.4], f)
     assert (b["last_held"], b["first_lost"], b["changes"]) == (0.1, 0.2, 2)
-    assert b["verdict"] == "chaotic, position lost" and b["ratio"] == pytest.approx(2.0)
+    assert b["verdict"] == "chaotic, position not tracked" and b["ratio"] == pytest.approx(2.0)
     with pytest.raises(ValueError, match="increasing"):
         weighting.stability_boundary([0.1, 0.0, 0.2, 0.3], f)
 

@@ -274,7 +274,8 @@ def find_orbits(step: Callable, pmap: PeriodMap, idx, hist, *, max_period: int, 
     ran; lag k is tried again only once the defect has halved.
 
     Returns a dict of (N,) arrays: found, k (least period), n (turns per k periods), lag
-    (the k of P^k Newton solved, a multiple of the least period, to which mult belong), x
+    (the k of P^k Newton solved, a multiple of the least period, to which mult belong),
+    rho (the largest |multiplier| of the least period's map P^k: |mu_1(P^lag)|^(k / lag)), x
     (the orbit point Newton found), mult (N, d) multipliers, residual, distance (of the
     last state to the orbit), near (N, d) the orbit point nearest to the last state, and
     status ("" no candidate, "not converged", "not attracting", "not reached", "found")
@@ -287,7 +288,8 @@ def find_orbits(step: Callable, pmap: PeriodMap, idx, hist, *, max_period: int, 
     cand, nslip, defect = lag_candidates(hist, max_period, candidate_tol, turn_axis=ax, turns=allow, ends=ends)
     if tried is not None:
         cand &= defect < 0.5 * tried
-    out = dict(found=np.zeros(N, bool), k=np.zeros(N, int), lag=np.zeros(N, int), n=np.zeros(N, int),
+    out = dict(found=np.zeros(N, bool), k=np.zeros(N, int), lag=np.zeros(N, int), rho=np.full(N, np.nan),
+               n=np.zeros(N, int),
                x=np.full((N, d), np.nan),
                mult=np.full((N, d), np.nan + 0j), residual=np.full(N, np.nan), distance=np.full(N, np.nan),
                near=np.full((N, d), np.nan), status=np.full(N, "", dtype=object), floquet=np.full(N, np.nan))
@@ -323,6 +325,7 @@ def find_orbits(step: Callable, pmap: PeriodMap, idx, hist, *, max_period: int, 
         g = a[hit]
         out["found"][g], out["status"][g] = True, "found"
         out["k"][g], out["n"][g], out["lag"][g] = kmin[hit], nmin[hit], kk
+        out["rho"][g] = rho[att][hit] ** (kmin[hit] / kk)
         out["x"][g], out["mult"][g], out["residual"][g] = xa[hit], mult[att][hit], res[att][hit]
         out["distance"][g] = d_now[hit]
         out["near"][g] = pts[j_now, np.arange(a.size)][hit]
