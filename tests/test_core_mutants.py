@@ -56,3 +56,177 @@ def test_state_difference_works_on_batches_of_states_and_leaves_its_inputs_alone
     # integer states: the heading's wrapped difference is not truncated to an integer
     di = state_difference([0, 0, 4, 0, 0, 0], [0, 0, 0, 0, 0, 0])
     assert di[2] == pytest.approx(4 - 2 * math.pi)
+
+
+# ------------------------------------------------------------------ model
+
+from lib import model  # noqa: E402
+from lib.allocation import Allocation, Limits  # noqa: E402
+from lib.closed_loop import ClosedLoop, reference_of  # noqa: E402
+from lib import control, trajectories as T  # noqa: E402
+
+
+def test_printed_drift_is_the_derived_one_plus_twice_v1_omega_in_the_v2_row_numerically():
+    # the numeric f_printed, not only the symbolic printed_drift, carries the typo of (6)
+    rng = np.random.default_rng(1)
+    q = rng.normal(size=(5, 6))
+    diff = model.f_printed(Body(), q) - model.f(Body(), q)
+    expected = np.zeros_like(q)
+    expected[:, 4] = 2 * q[:, 3] * q[:, 5]
+    np.testing.assert_allclose(diff, expected, rtol=1e-14, atol=1e-14)
+    np.testing.assert_allclose(model.state_rhs(Body(), q, 1.5, 0.3, printed=True)
+                               - model.state_rhs(Body(), q, 1.5, 0.3), expected, rtol=1e-14, atol=1e-14)
+
+
+def test_drift_of_a_batch_of_states_is_the_drift_of_each():
+    rng = np.random.default_rng(2)
+    q = rng.normal(size=(3, 4, 6))
+    out = model.f(Body(), q)
+    assert out.shape == q.shape
+    for idx in np.ndindex(3, 4):
+        np.testing.assert_array_equal(out[idx], model.f(Body(), q[idx]))
+
+
+def test_input_matrix_of_an_integer_angle_keeps_the_lever_arm():
+    # B(phi)'s last row is [0, a]; an integer phi must not make it an integer array (a = 0.4)
+    B = model.input_matrix(0, Body())
+    np.testing.assert_array_equal(B, [[1.0, -0.0], [0.0, 1.0], [0.0, 0.4]])
+    np.testing.assert_array_equal(model.input_matrix(np.array([0, 0]), Body())[:, 2], [[0.0, 0.4]] * 2)
+
+
+def test_config_from_state_of_an_integer_state_is_float():
+    z, dz = model.config_from_state([1, 2, 3, 4, 5, 6])
+    assert z.dtype == float and dz.dtype == float
+    np.testing.assert_array_equal(z, [1.0, 2.0, 3.0])
+
+
+@pytest.mark.parametrize("call, name", [
+    (lambda: model.config_accel(Body(), np.zeros(3), np.zeros(2), 1.0, 0.0), "dz"),
+    (lambda: model.config_accel(Body(), np.zeros(4), np.zeros(3), 1.0, 0.0), "z"),
+    (lambda: model.state_from_config(np.zeros(2), np.zeros(3)), "z"),
+    (lambda: model.state_from_config(np.zeros(3), np.zeros(4)), "dz"),
+    (lambda: model.config_from_state(np.zeros(5)), "q"),
+    (lambda: model.f(Body(), np.zeros(7)), "q"),
+])
+def test_a_wrong_shape_is_named_in_the_error(call, name):
+    with pytest.raises(ValueError, match=rf"^{name} must have a last axis of length \d, got shape"):
+        call()
+
+
+# ------------------------------------------------------------------ closed loop
+
+
+def test_closed_loop_rates_of_a_batch_are_the_rates_of_each_state():
+    loop = ClosedLoop.of(Body(), Gains(), reference_of(T.eight()))
+    rng = np.random.default_rng(3)
+    s = rng.normal(size=(4, 6))
+    rates, F = loop.rates(1.3, s)
+    assert rates.shape == (4, 6) and F.shape == (4,)
+    for i in range(4):
+        r_i, F_i = loop.rates(1.3, s[i])
+        np.testing.assert_allclose(rates[i], r_i, rtol=1e-15, atol=1e-15)
+        assert F[i] == pytest.approx(float(F_i), rel=1e-15)
+
+
+def test_closed_loop_uses_the_allocation_it_is_given():
+    # the least-squares law with a weight on tau_phi is not the position-only one
+    kin = reference_of(T.eight())
+    s = np.array([1.0, 0.2, 0.3, 0.1, -0.2, 0.5])
+    paper = ClosedLoop.of(Body(), Gains(), kin).rates(2.0, s)[0]
+    weighted = ClosedLoop.of(Body(), Gains(), kin, Allocation("least_squares", (1.0, 1.0, 1.0))).rates(2.0, s)[0]
+    assert np.abs(paper - weighted).max() > 1e-3
+    limited = ClosedLoop.of(Body(), Gains(), kin, limits=Limits(force=0.1)).inputs(2.0, s[:3], s[3:])[1]
+    assert limited <= 0.1
+
+
+def test_closed_loop_names_a_wrong_part():
+    kin = reference_of(T.eight())
+    with pytest.raises(TypeError, match=r"^gains must be a lib\.params\.Gains, got str$"):
+        ClosedLoop.of(Body(), "kp", kin)
+    with pytest.raises(TypeError, match=r"^allocation must be a lib\.allocation\.Allocation, got str$"):
+        ClosedLoop.of(Body(), Gains(), kin, "least_squares")
+
+
+# ------------------------------------------------------------------ trajectories
+
+
+def test_references_default_to_the_papers_table():
+    assert T.circle() == T.Circle(2.0, math.pi / 4)
+    assert T.eight() == T.Eight(2.0, math.pi / 4)
+
+
+def test_reference_parameters_are_stored_as_floats():
+    for ref in (T.Circle(2, 1), T.Eight(np.float32(1.5), np.int64(2))):
+        assert type(ref.R) is float and type(ref.theta) is float
+
+
+@pytest.mark.parametrize("R", [True, [1.0, 2.0], np.array([1.0, 2.0])])
+def test_reference_rejects_a_bool_or_an_array_radius(R):
+    for factory in (T.circle, T.eight):
+        with pytest.raises(ValueError, match="R must be a finite real number"):
+            factory(R, 1.0)
+
+
+def test_eight_heading_is_the_third_entry_of_z():
+    ref = T.eight(1.5, 0.8)
+    t = np.linspace(0.0, 10.0, 11)
+    np.testing.assert_array_equal(ref.heading(t), ref.z(t)[:, 2])
+
+
+def test_eight_heading_oscillates_about_pi_forwards_and_about_zero_backwards():
+    # the continuous branch: mean pi over a period for theta > 0, 0 for theta < 0 (the
+    # body faces the other way when the eight is run backwards)
+    for theta, mean in ((0.7, math.pi), (-0.7, 0.0)):
+        ref = T.eight(2.0, theta)
+        t = np.linspace(0.0, ref.period, 2001)[:-1]
+        h = ref.heading(t)
+        assert abs(h.mean() - mean) < 1e-9 and np.all(np.abs(h - mean) < math.pi)
+
+
+def test_position_kinematics_of_a_path_runs_on_python_floats():
+    # the switched integrator's scalar path: math.cos / math.sin, not numpy's
+    for ref in (T.circle(), T.eight()):
+        out = T.position_kinematics(ref)(0.7)
+        assert all(type(v) is float for v in out), [type(v) for v in out]
+
+
+def test_eight_heading_fourier_coefficients_are_the_cosine_integrals():
+    # a_k = (1/pi) int_0^{2 pi} phi_d(s) cos(k s) ds (a_0 the mean), by adaptive quadrature;
+    # measured agreement 3.4e-15 (k <= 7), tolerance 1e-12
+    from scipy.integrate import quad
+
+    phi = lambda s: T.eight_kinematics(1.0, 1.0, s)[0][..., 2]  # noqa: E731
+    a = T.eight_heading_fourier(7)
+    assert a.shape == (8,)
+    for k in range(8):
+        ref = quad(lambda s: float(phi(s)) * math.cos(k * s), 0.0, 2 * math.pi, limit=200,
+                   epsabs=1e-12, epsrel=0)[0] / (2 * math.pi if k == 0 else math.pi)
+        assert abs(a[k] - ref) < 1e-12, (k, a[k], ref)
+    assert a[0] == pytest.approx(math.pi, abs=1e-12)
+    np.testing.assert_allclose(a[2::2], 0.0, atol=1e-12)  # only odd harmonics
+    assert T.eight_heading_fourier().shape == (10,) and T.eight_heading_fourier(0).shape == (1,)
+    with pytest.raises(ValueError, match="n_harmonics must be a non-negative integer"):
+        T.eight_heading_fourier(-1)
+    with pytest.raises(ValueError, match="n_harmonics must be a non-negative integer"):
+        T.eight_heading_fourier(2.0)
+
+
+def test_heading_series_sums_its_cosines_and_converges_to_the_heading():
+    s = np.linspace(0.0, 2 * math.pi, 9)
+    np.testing.assert_allclose(T.heading_series({0: 1.0, 2: 0.5}, s), 1.0 + 0.5 * np.cos(2 * s), rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(T.heading_series({1: 2.0}, [0, 1]), 2.0 * np.cos([0.0, 1.0]))
+    a = T.eight_heading_fourier(41)
+    series = T.heading_series({k: a[k] for k in range(42)}, s)
+    np.testing.assert_allclose(series, T.eight_kinematics(1.0, 1.0, s)[0][..., 2], atol=1e-2)
+
+
+# ------------------------------------------------------------------ control
+
+
+def test_error_dynamics_solution_keeps_the_shape_of_its_times():
+    e0, de0 = np.array([0.3, -0.2, 0.1]), np.array([0.0, 0.5, -0.4])
+    t = np.linspace(0.0, 3.0, 6).reshape(2, 3)
+    out = control.error_dynamics_solution(Body(), Gains(), e0, de0, t)
+    assert out.shape == (2, 3, 3)
+    np.testing.assert_allclose(out.reshape(6, 3), control.error_dynamics_solution(Body(), Gains(), e0, de0,
+                                                                                  t.ravel()), rtol=1e-15)
