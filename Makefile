@@ -25,8 +25,9 @@ book: $(STAMP)
 	@echo "Book built: $(CURDIR)/_build/html/index.html"
 
 # Reuses the book `make book` built when it is current, builds it otherwise (BOOK_REBUILD=1 forces).
+# Two workers: one builds the book and reads it in the browser, the other runs the rest.
 test: $(STAMP)
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest -n 2 --dist loadgroup
 
 benchmark: $(STAMP)
 	$(BIN)/python benchmarks/bench_switched.py

@@ -28,7 +28,7 @@ from .rotation_engine import RotationMap, _Engine, orbit_range, verdict_steps
 from .rotation_field import coefficients
 
 __all__ = ["REGIMES", "VERDICT_DEFAULTS", "SLOW_FLOQUET", "verdict_steps", "section_returns", "rotation_verdicts",
-           "eight_rotation_sweep"]
+           "eight_rotation_sweep", "FIG5_GRID", "fig5_map"]
 
 #: the verdicts of :func:`rotation_verdicts` (defined in :mod:`lib.dynamics.verdicts`)
 REGIMES = dv.REGIMES
@@ -42,6 +42,18 @@ def eight_rotation_sweep(body: Body, R, Theta, **options) -> pd.DataFrame:
     (Newton on the period map of (32) and the largest Lyapunov exponent). See there for
     the options and the columns (including ``lost``)."""
     return rotation_verdicts(body, "eight", R, Theta, **options)
+
+
+#: the book's Fig. 5 grid: n x n points, R evenly in ``R`` (m), Theta evenly in ``Theta`` (rad/s)
+FIG5_GRID = MappingProxyType(dict(R=(0.25, 4.0), Theta=(0.05, 1.5), n=100))
+
+
+def fig5_map(body: Body, n: int = FIG5_GRID["n"]) -> pd.DataFrame:
+    """The book's Fig. 5 (Chapter 5, and the report's row on it): :func:`eight_rotation_sweep`
+    on the n x n grid :data:`FIG5_GRID`, Theta varying slowest."""
+    n = _check_int("n", n, 2)
+    R, Th = np.meshgrid(np.linspace(*FIG5_GRID["R"], n), np.linspace(*FIG5_GRID["Theta"], n))
+    return eight_rotation_sweep(body, R.ravel(), Th.ravel())
 
 
 def _check_body_kind(body, kind):

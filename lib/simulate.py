@@ -229,6 +229,10 @@ def _demo_angle(t):
 DEMO_Q0 = (0.0, 0.0, 0.0, 0.5, 0.0, 0.2)
 
 
+#: the horizon (s) of the open-loop comparison, in Chapter 1 and in the report
+OPEN_LOOP_HORIZON = 20.0
+
+
 def open_loop_comparison(body: Body, t_end: float, *, F=_demo_force, beta=_demo_angle,
                          q0=DEMO_Q0) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Run every model form of :data:`OPEN_LOOP_FORMS` with the same inputs and initial state.

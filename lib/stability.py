@@ -17,7 +17,7 @@ from .circle_rotation import (circle_critical_radius, circle_eigenvalues, circle
 from .rotation import (ENGINES, classify_samples, reduced_rotation, rotation_sweep, sampled_range,
                        steps_per_period)
 from .rotation_attractor import MapSummary, RotationAttractor, map_summary, rotation_attractor
-from .rotation_verdicts import REGIMES, eight_rotation_sweep, rotation_verdicts
+from .rotation_verdicts import FIG5_GRID, REGIMES, eight_rotation_sweep, fig5_map, rotation_verdicts
 from .rotation_equations import (RotationEquation, corrected_p0, derive_eight_equation, derive_rotation_equation,
                                  printed_eq33, printed_eq37, printed_p0)
 from .trajectories import PAPER_HEADING_SERIES, eight_heading_fourier, heading_series
@@ -27,6 +27,6 @@ __all__ = [
     "corrected_p0", "printed_p0", "circle_equilibria", "circle_critical_radius", "circle_eigenvalues",
     "circle_jacobian", "circle_rotation_rhs", "circle_final_state", "circle_slipping_coexists",
     "steps_per_period", "reduced_rotation", "classify_samples", "sampled_range", "rotation_sweep",
-    "eight_rotation_sweep", "REGIMES", "rotation_verdicts", "rotation_attractor", "RotationAttractor",
+    "eight_rotation_sweep", "fig5_map", "FIG5_GRID", "REGIMES", "rotation_verdicts", "rotation_attractor", "RotationAttractor",
     "map_summary", "MapSummary", "ENGINES", "eight_heading_fourier", "heading_series", "PAPER_HEADING_SERIES",
 ]

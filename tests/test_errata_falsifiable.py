@@ -17,7 +17,7 @@ import pytest
 import sympy as sp
 
 from lib.controllability import paper_bracket_count, witt_dimension
-from lib.paper import errata, model_errata
+from lib.paper import errata, model_errata, reading_errata as rd
 from lib.paper.rotation_errata import CORRECTED_HEADING_SERIES
 from lib.rotation_equations import (corrected_p0, derive_eight_equation, derive_rotation_equation, printed_eq33,
                                     printed_eq37, printed_p0)
@@ -101,6 +101,16 @@ CASES = {
     "eq37-bracket": _eq37_cases,
     "fourier-a3": lambda: [dict(printed=CORRECTED_HEADING_SERIES, corrected=PAPER_HEADING_SERIES),
                            dict(printed=CORRECTED_HEADING_SERIES, corrected={**CORRECTED_HEADING_SERIES, 5: 0.17})],
+    # the line-by-line audit (lib.paper.reading_errata)
+    "def2-stlc": lambda: [dict(printed=rd._interior, corrected=rd._membership),
+                          dict(printed=rd._interior, corrected=lambda lo, hi, q: True)],
+    "eq19-20-symbols": lambda: [dict(printed="g", corrected="q"), dict(printed="g", corrected="f")],
+    "eq22-23-N-order": lambda: [dict(printed=(("z'", "z"), ("z'", "z")), corrected=(("z'", "z"), ("z", "z'")))],
+    "eq24-rows": lambda: [dict(printed=(0, 1), corrected=(0, 1, 2)), dict(printed=(0,), corrected=(2,))],
+    "eq28-arg-branch": lambda: [dict(printed=rd._continuous_heading, corrected=rd.printed_eight_heading),
+                                dict(printed=rd._continuous_heading,
+                                     corrected=lambda s: rd._continuous_heading(s) + 0.01)],
+    "theta-symbol": lambda: [dict(printed=("theta",), corrected=("Theta", "theta"))],
 }
 
 

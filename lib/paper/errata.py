@@ -7,7 +7,9 @@ live verdict and the test suite iterates the same list, so a row cannot exist
 without its check.
 
 Rows are grouped by the paper's sections in :mod:`.model_errata` (Secs. 2-3),
-:mod:`.tracking_errata` (Secs. 4-5) and :mod:`.rotation_errata` (Sec. 6), each
+:mod:`.tracking_errata` (Secs. 4-5), :mod:`.rotation_errata` (Sec. 6) and
+:mod:`.reading_errata` (slips of notation and definitions found by a line-by-line
+audit, with two that change a computation: (24) and (28)), each
 importing the domain modules whose computations prove its rows; no domain
 module imports this subpackage.
 """
@@ -16,13 +18,13 @@ from __future__ import annotations
 
 import pandas as pd
 
-from . import model_errata, rotation_errata, tracking_errata
+from . import model_errata, reading_errata, rotation_errata, tracking_errata
 from .verdicts import Erratum, Verdict
 
 __all__ = ["Erratum", "Verdict", "rows", "table", "SOURCES"]
 
 #: the modules that contribute rows, in the order of the paper's sections
-SOURCES = (model_errata, tracking_errata, rotation_errata)
+SOURCES = (model_errata, tracking_errata, rotation_errata, reading_errata)
 
 
 def rows() -> list[Erratum]:

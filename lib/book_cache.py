@@ -1,0 +1,93 @@
+"""A result computed once per build and shared by the book's notebooks.
+
+Two pages sometimes need the same expensive computation: the reproduction report
+quotes the Fig. 5 map that Chapter 5 draws, and the angle-limit sweep that
+Chapter 4 draws. Each notebook runs in its own kernel, so :func:`cached` keeps the
+result on disk, under ``_build/.cache`` of the book being built, keyed by the
+function, its arguments and the source of every module of ``lib``: a change to
+the library or to the arguments computes afresh (``make clean`` removes the cache).
+The time the computation took is kept with it (:func:`cached_timed`), so that a page
+quoting it quotes the computation, not the reading of the cache.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import pickle
+import time
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+__all__ = ["cached", "cached_timed", "cache_dir"]
+
+_LIB = Path(__file__).resolve().parent
+
+
+def cache_dir(start: Path | None = None) -> Path:
+    """``_build/.cache`` of the book that contains ``start`` (default: the working directory):
+    the nearest folder upwards that holds ``_config.yml``. Raises FileNotFoundError outside a book."""
+    here = Path(start or os.getcwd()).resolve()
+    for d in (here, *here.parents):
+        if (d / "_config.yml").is_file() and (d / "_toc.yml").is_file():
+            return d / "_build" / ".cache"
+    raise FileNotFoundError(f"no book (_config.yml and _toc.yml) at or above {here}")
+
+
+def _feed(h, value) -> None:
+    if isinstance(value, np.ndarray):
+        h.update(repr((value.dtype.str, value.shape)).encode())
+        h.update(np.ascontiguousarray(value).tobytes())
+    elif isinstance(value, (list, tuple)):
+        h.update(f"{type(value).__name__}{len(value)}".encode())
+        for v in value:
+            _feed(h, v)
+    elif isinstance(value, dict):
+        for k in sorted(value):
+            h.update(repr(k).encode())
+            _feed(h, value[k])
+    else:
+        h.update(repr(value).encode())
+
+
+def _key(fn: Callable, args, kwargs) -> str:
+    h = hashlib.sha256()
+    h.update(f"{fn.__module__}.{fn.__qualname__}".encode())
+    for path in sorted(_LIB.rglob("*.py")):
+        h.update(path.relative_to(_LIB).as_posix().encode())
+        h.update(path.read_bytes())
+    _feed(h, list(args))
+    _feed(h, dict(kwargs))
+    return h.hexdigest()[:32]
+
+
+def cached(fn: Callable, *args, **kwargs) -> Any:
+    """``fn(*args, **kwargs)``, computed once per state of the library and shared between the
+    notebooks of one book build (a pickle under :func:`cache_dir`). The arguments must have a
+    faithful ``repr`` (numbers, strings, arrays, the frozen parameter dataclasses)."""
+    return cached_timed(fn, *args, **kwargs)[0]
+
+
+def cached_timed(fn: Callable, *args, **kwargs) -> tuple[Any, float]:
+    """:func:`cached`, and the wall time (s) the computation took when it was done. Outside a
+    book (no ``_config.yml`` above the working directory) it simply computes."""
+    try:
+        path = cache_dir() / f"{fn.__name__}-{_key(fn, args, kwargs)}.pkl"
+    except FileNotFoundError:
+        tic = time.perf_counter()
+        result = fn(*args, **kwargs)
+        return result, time.perf_counter() - tic
+    if path.is_file():
+        with path.open("rb") as fh:
+            return pickle.load(fh)
+    tic = time.perf_counter()
+    result = fn(*args, **kwargs)
+    out = (result, time.perf_counter() - tic)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(f".{os.getpid()}.tmp")
+    with tmp.open("wb") as fh:
+        pickle.dump(out, fh)
+    tmp.replace(path)
+    return out

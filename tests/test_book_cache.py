@@ -1,0 +1,57 @@
+"""lib.book_cache: one computation shared by two pages of one build, never a stale one."""
+
+import numpy as np
+import pytest
+
+from lib import book_cache
+
+
+CALLS = []
+
+
+def _square(x, scale=1.0):
+    CALLS.append(1)
+    return np.asarray(x) ** 2 * scale
+
+
+@pytest.fixture
+def book(tmp_path, monkeypatch):
+    (tmp_path / "_config.yml").write_text("title: t\n")
+    (tmp_path / "_toc.yml").write_text("root: intro\n")
+    (tmp_path / "chapters").mkdir()
+    monkeypatch.chdir(tmp_path / "chapters")          # notebooks run in their own folder
+    CALLS.clear()
+    return tmp_path
+
+
+def test_a_second_call_reads_what_the_first_computed_with_its_time(book):
+    a, t1 = book_cache.cached_timed(_square, np.arange(3.0))
+    b, t2 = book_cache.cached_timed(_square, np.arange(3.0))
+    assert len(CALLS) == 1 and np.array_equal(a, b) and t1 == t2 >= 0
+    assert book_cache.cache_dir() == book / "_build" / ".cache"
+    assert len(list((book / "_build" / ".cache").glob("_square-*.pkl"))) == 1
+
+
+def test_other_arguments_compute_afresh(book):
+    book_cache.cached(_square, np.arange(3.0))
+    book_cache.cached(_square, np.arange(3.0), scale=2.0)
+    book_cache.cached(_square, np.arange(4.0))
+    book_cache.cached(_square, np.arange(3.0).astype(np.float32))
+    assert len(CALLS) == 4
+
+
+def test_a_change_to_the_library_computes_afresh(book, monkeypatch):
+    book_cache.cached(_square, 2.0)
+    monkeypatch.setattr(book_cache, "_LIB", book)       # another library: another key
+    (book / "mod.py").write_text("x = 1\n")
+    book_cache.cached(_square, 2.0)
+    assert len(CALLS) == 2
+
+
+def test_outside_a_book_it_simply_computes(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    CALLS.clear()
+    assert book_cache.cached(_square, 3.0) == 9.0 and book_cache.cached(_square, 3.0) == 9.0
+    assert len(CALLS) == 2 and not (tmp_path / "_build").exists()
+    with pytest.raises(FileNotFoundError, match="no book"):
+        book_cache.cache_dir()
