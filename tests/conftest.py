@@ -4,6 +4,7 @@ left a current build there."""
 
 from __future__ import annotations
 
+import fcntl
 import os
 import subprocess
 import sys
@@ -57,13 +58,25 @@ def built_book() -> subprocess.CompletedProcess:
     """The book built by ``jupyter-book build --all -W -n --keep-going .``: the one
     ``make book`` left in ``_build`` when it is current (see ``_current_build``),
     otherwise built now, leaving the same ``build.log`` and ``build.rc``.
-    ``BOOK_REBUILD=1`` forces a build."""
-    if os.environ.get("BOOK_REBUILD", "") in ("", "0") and (done := _current_build()) is not None:
+    ``BOOK_REBUILD=1`` forces a build. Under pytest-xdist the workers take a lock on
+    ``_build``: one builds, another that needs the book waits and then reuses that build."""
+    build = ROOT / "_build"
+    build.mkdir(exist_ok=True)
+    with open(build / ".build.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        return _build_or_reuse(build, force=os.environ.get("BOOK_REBUILD", "") not in ("", "0"))
+
+
+#: when this test process started: a build begun since then is this session's own
+_SESSION_START = time.time()
+
+
+def _build_or_reuse(build: Path, force: bool) -> subprocess.CompletedProcess:
+    done = _current_build()
+    if done is not None and (not force or (build / "build.log").stat().st_mtime >= _SESSION_START):
         return done
     exe = Path(sys.executable).with_name("jupyter-book")
     env = dict(os.environ, PYTHONWARNINGS="default")
-    build = ROOT / "_build"
-    build.mkdir(exist_ok=True)
     (build / "build.rc").unlink(missing_ok=True)
     began = time.time()
     proc = subprocess.run([str(exe), *BUILD_CMD], cwd=ROOT, env=env,

@@ -15,8 +15,6 @@ ROOT = Path(__file__).resolve().parents[1]
 CODE_WIDTH = 77
 FOLDED_CODE_WIDTH = 75
 HIDDEN_TAGS = {"remove-input", "remove-cell"}
-# the build runs on one worker while the other runs the rest (pytest-xdist, --dist loadgroup)
-pytestmark = pytest.mark.xdist_group("book")
 
 
 @pytest.mark.book

@@ -31,8 +31,7 @@ from urllib.parse import urlparse
 import pytest
 import yaml
 
-# one worker builds the book and then reads it (pytest-xdist, --dist loadgroup)
-pytestmark = [pytest.mark.browser, pytest.mark.xdist_group("book")]
+pytestmark = pytest.mark.browser
 
 ROOT = Path(__file__).resolve().parents[1]
 BUILD = ROOT / "_build"

@@ -52,7 +52,7 @@ from .orbits import NewtonResult, floquet_multipliers, newton
 
 __all__ = ["REGIMES", "SIGMAS", "PeriodMap", "lag_candidates", "difference_jacobian", "newton", "NewtonResult", "least_period",
            "distance_to_orbit", "reached", "block_statistics", "batch_means", "drift_statistics", "section_returns", "classify",
-           "heading_lost", "turns_round", "held", "orbit_regime", "orbit_points", "find_orbits", "enclosed_orbit"]
+           "heading_lost", "turns_round", "held", "redecide_undecided", "orbit_regime", "orbit_points", "find_orbits", "enclosed_orbit"]
 
 #: the verdicts, in the order the book lists them
 REGIMES = ("periodic", "slipping", "chaotic", "quasiperiodic", "undecided")
@@ -329,6 +329,22 @@ def find_orbits(step: Callable, pmap: PeriodMap, idx, hist, *, max_period: int, 
         out["x"][g], out["mult"][g], out["residual"][g] = xa[hit], mult[att][hit], res[att][hit]
         out["distance"][g] = d_now[hit]
         out["near"][g] = pts[j_now, np.arange(a.size)][hit]
+    return out
+
+
+def redecide_undecided(frame, horizon: int, factor: int, redo: Callable):
+    """A copy of a verdict frame (one row per run, column ``regime``) whose ``undecided`` rows
+    are decided again by ``redo(rows, factor)`` (a frame for those rows, over ``factor`` times
+    the ``horizon`` in periods), with a column ``horizon``: the periods each row was observed."""
+    out = frame.copy()
+    out["horizon"] = horizon
+    todo = np.flatnonzero((frame.regime == "undecided").to_numpy())
+    if todo.size == 0:
+        return out
+    redone = redo(todo, factor)
+    redone["horizon"] = horizon * factor
+    redone.index = frame.index[todo]
+    out.loc[redone.index, redone.columns] = redone
     return out
 
 
