@@ -26,10 +26,12 @@ from .integrators import batch
 from .loop_verdicts import LOOP_VERDICT_DEFAULTS, _check_loop, _points, closed_loop_verdicts, held, verdict_runs
 from .params import Body, Gains
 from .trajectories import KINEMATICS
+from .weighted_circle import circle_error_weight, circle_steady_state, circle_weight_limit, circle_weight_sweep
 
 __all__ = ["BatchResult", "closed_loop_batch", "steady_metrics", "LOOP_VERDICT_DEFAULTS", "closed_loop_verdicts",
            "verdict_runs", "held", "stability_boundary", "refine_boundary", "extend_undecided", "MapComparison", "compare_on_map",
-           "limits_comparison"]
+           "limits_comparison", "circle_steady_state", "circle_weight_limit", "circle_weight_sweep",
+           "circle_error_weight"]
 
 
 @dataclass(frozen=True)
