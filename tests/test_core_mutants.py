@@ -167,6 +167,12 @@ def test_reference_rejects_a_bool_or_an_array_radius(R):
             factory(R, 1.0)
 
 
+def test_a_standstill_reference_is_rejected_with_its_reason():
+    for factory in (T.circle, T.eight):
+        with pytest.raises(ValueError, match=r"^trajectory angular rate theta must be non-zero \(theta = 0"):
+            factory(1.0, 0.0)
+
+
 def test_eight_heading_is_the_third_entry_of_z():
     ref = T.eight(1.5, 0.8)
     t = np.linspace(0.0, 10.0, 11)
@@ -230,3 +236,49 @@ def test_error_dynamics_solution_keeps_the_shape_of_its_times():
     assert out.shape == (2, 3, 3)
     np.testing.assert_allclose(out.reshape(6, 3), control.error_dynamics_solution(Body(), Gains(), e0, de0,
                                                                                   t.ravel()), rtol=1e-15)
+
+
+# ------------------------------------------------------------------ allocation
+
+from lib import allocation as A  # noqa: E402
+
+
+def test_allocation_weights_are_a_read_only_float_array():
+    for alloc in (Allocation(), Allocation("least_squares", [1, 2, 3])):
+        w = alloc.weights
+        assert isinstance(w, np.ndarray) and w.dtype == float and not w.flags.writeable
+        with pytest.raises(ValueError):
+            w[0] = 5.0
+
+
+def test_allocation_bound_without_limits_is_the_unlimited_law():
+    tau = np.array([[1.0, -2.0, 0.3], [0.0, 0.5, -1.0]])
+    phi = np.array([0.2, -1.1])
+    F, beta = Allocation().bind(Body())(tau, phi)
+    F0, beta0 = A.allocate(tau, phi)
+    np.testing.assert_array_equal(F, F0)
+    np.testing.assert_array_equal(beta, beta0)
+    F, beta = Allocation("least_squares", (1.0, 1.0, 2.0)).bind(Body())(tau, phi)
+    F0, beta0 = A.allocate_least_squares(tau, phi, Body(), (1.0, 1.0, 2.0))
+    np.testing.assert_allclose(F, F0, rtol=1e-15)
+    np.testing.assert_allclose(beta, beta0, rtol=1e-15)
+    with pytest.raises(TypeError, match=r"^limits must be a lib\.allocation\.Limits, got str$"):
+        Allocation().bind(Body(), "none")
+
+
+@pytest.mark.parametrize("law", [A.allocate_least_squares, A.allocate_limited])
+def test_zero_demand_needs_no_force_and_points_nowhere(law):
+    # F = 0 and beta = 0 by definition, for every heading and either sign of zero
+    phi = np.linspace(-3.0, 3.0, 13)
+    for tau in ([0.0, 0.0, 0.0], [-0.0, -0.0, -0.0], [0.0, -0.0, 0.0]):
+        for w in ((1.0, 1.0, 0.0), (1.0, 2.0, 0.5)):
+            F, beta = law(np.array(tau), phi, Body(), w)
+            np.testing.assert_array_equal(F, 0.0)
+            np.testing.assert_array_equal(beta, 0.0)
+
+
+def test_a_wrong_demand_shape_names_the_three_components():
+    with pytest.raises(ValueError, match=r"^tau must have a last axis of length 3 \(tau_x, tau_y, tau_phi\), got"):
+        A.allocate_least_squares(np.zeros(2), 0.0, Body())
+    with pytest.raises(ValueError, match=r"^tau must have a last axis of length 2 or 3, got"):
+        A.allocate(np.zeros(4), 0.0)
