@@ -282,3 +282,12 @@ def test_a_wrong_demand_shape_names_the_three_components():
         A.allocate_least_squares(np.zeros(2), 0.0, Body())
     with pytest.raises(ValueError, match=r"^tau must have a last axis of length 2 or 3, got"):
         A.allocate(np.zeros(4), 0.0)
+
+
+def test_limited_allocation_does_not_admit_an_optimum_behind_the_body_of_unit_size():
+    # tau = (-1, 0, 0) at phi = 0 with w_phi = 0: the unconstrained optimum u* = (-1, 0) has
+    # |u*| = 1 N exactly and points straight behind the body, outside a 0.5 rad sector; the
+    # best admissible force is zero (J grows along both rays of the sector)
+    for cap in (None, 3.0):
+        F, beta = A.allocate_limited(np.array([-1.0, 0.0, 0.0]), 0.0, Body(), angle_limit=0.5, force_limit=cap)
+        assert abs(beta) <= 0.5 and F == 0.0, (F, beta)
