@@ -42,6 +42,7 @@ test: $(STAMP)
 benchmark: $(STAMP)
 	$(BIN)/python benchmarks/bench_switched.py
 	$(BIN)/python benchmarks/bench_eight_sweep.py
+	$(BIN)/python benchmarks/bench_scale.py
 
 clean:
 	rm -rf _build

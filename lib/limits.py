@@ -25,7 +25,7 @@ from .dynamics.lyapunov import LyapunovEstimate, largest_lyapunov
 from .dynamics.sections import distinct_points, section_margin, section_period
 from .integrators.batch import dop853
 from .integrators.switched import Segments, SwitchedLoop
-from .parallel import map_in_processes
+from .parallel import map_chunks, map_in_processes
 from .params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from .rotation import sampled_extremes, sampled_range
 from .trajectories import Circle, Eight, Reference
@@ -205,6 +205,25 @@ def _limits_arrays(angle_limits, force_limits):
     return b.copy(), f.copy()
 
 
+def _start_states(s0, n: int) -> np.ndarray:
+    """The start of each of ``n`` runs (n, 6): the paper's initial state, or ``s0`` (6,) or (n, 6)."""
+    S0 = np.concatenate([PAPER_Z0, PAPER_DZ0]) if s0 is None else np.asarray(s0, dtype=float)
+    S0 = np.broadcast_to(S0, (n, 6)) if S0.shape == (6,) or S0.shape == (1, 6) else S0
+    if S0.shape != (n, 6) or not np.all(np.isfinite(S0)):
+        raise ValueError(f"s0 must be a finite state (6,) or one per run ({n}, 6), got shape {S0.shape}")
+    return S0
+
+
+def _concat_runs(parts: list) -> SwitchedRuns:
+    """The :class:`SwitchedRuns` of consecutive chunks of runs as one (the runs in order)."""
+    if len(parts) == 1:
+        return parts[0]
+    shared = ("period", "t", "lyapunov_from")
+    return SwitchedRuns(**{name: getattr(parts[0], name) if name in shared else
+                           np.concatenate([getattr(r, name) for r in parts])
+                           for name in SwitchedRuns.__dataclass_fields__})
+
+
 def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_limits=None, *, s0=None,
                   n_periods: int, lyapunov_from: int | None = None, steps_per_period: int = STEPS_PER_PERIOD,
                   samples_per_period: int = 1, d0: float = 1e-7, k_slide: float = 5.0) -> SwitchedRuns:
@@ -243,10 +262,7 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
         raise ValueError("the Lyapunov companion needs samples_per_period = 1")
     if not (np.isfinite(d0) and 0 < d0 < 1e-3):
         raise ValueError(f"d0 must be in (0, 1e-3), got {d0!r}")
-    S0 = np.concatenate([PAPER_Z0, PAPER_DZ0]) if s0 is None else np.asarray(s0, dtype=float)
-    S0 = np.broadcast_to(S0, (b.size, 6)) if S0.shape == (6,) or S0.shape == (1, 6) else S0
-    if S0.shape != (b.size, 6) or not np.all(np.isfinite(S0)):
-        raise ValueError(f"s0 must be a finite state (6,) or one per run ({b.size}, 6), got shape {S0.shape}")
+    S0 = _start_states(s0, b.size)
     g = gains
     P = np.array([body.m, body.I, body.a, body.c, body.c_phi, g.kp[0], g.kp[1], g.kv[0], g.kv[1], ref.R, ref.theta,
                   k_slide, 0.0 if isinstance(ref, Circle) else 1.0])
@@ -302,7 +318,8 @@ class _SwitchedMap:
 
 
 def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force_limits=None, *, s0=None,
-                   steps_per_period: int = STEPS_PER_PERIOD, **options):
+                   steps_per_period: int = STEPS_PER_PERIOD, executor=None, chunk_size: int | None = None,
+                   **options):
     """Decide the long-run regime of the switched closed loop for each (angle limit (rad),
     force limit (N)) pair by the book's one decision procedure (:mod:`lib.dynamics.verdicts`)
     on the full state. Options (:data:`LIMIT_DEFAULTS`): ``transient`` periods dropped,
@@ -334,15 +351,39 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
     crossings, slides, t_sliding (s), reason, and orbit (the located orbit's state at t = 0,
     [x, y, phi, xdot, ydot, phidot], or None).
 
+    Scale-out: with an ``executor`` (any :class:`concurrent.futures.Executor`) the pairs go to
+    it in consecutive chunks of ``chunk_size`` (default: two chunks per worker; without an
+    executor, ``chunk_size`` runs the chunks here one after another), by
+    :func:`lib.parallel.map_chunks`; each run is decided on its own, so the frame is the one
+    of the single call, and the runs' arrays are concatenated in order into one
+    :class:`SwitchedRuns`.
+
     Returns (a DataFrame with one row per pair, the :class:`SwitchedRuns`)."""
     unknown = set(options) - set(LIMIT_DEFAULTS)
     if unknown:
         raise TypeError(f"unknown options {sorted(unknown)}; known: {sorted(LIMIT_DEFAULTS)}")
     o = {**LIMIT_DEFAULTS, **options}
-    ntr, npr, blk, kmax = o["transient"], o["periods"], o["block"], o["max_period"]
+    npr, blk, kmax = o["periods"], o["block"], o["max_period"]
     if npr < 2 * blk or npr < 2 * kmax + 2:
         raise ValueError(f"periods ({npr}) must cover two blocks ({blk}) and twice max_period ({kmax})")
-    runs = switched_runs(body, gains, ref, angle_limits, force_limits, s0=s0, n_periods=ntr + npr,
+    if not isinstance(body, Body) or not isinstance(gains, Gains):
+        raise TypeError("body and gains must be lib.params.Body and lib.params.Gains")
+    if not isinstance(ref, (Circle, Eight)):
+        raise TypeError(f"ref must be lib.trajectories.Circle or Eight, got {type(ref).__name__}")
+    b, f = _limits_arrays(angle_limits, force_limits)
+    S0 = _start_states(s0, b.size)
+    parts = map_chunks(_limit_chunk, b.size, (b, f, S0), dict(body=body, gains=gains, ref=ref, o=o,
+                                                             steps_per_period=steps_per_period),
+                       executor, chunk_size)
+    if len(parts) == 1:
+        return parts[0]
+    return pd.concat([p[0] for p in parts], ignore_index=True), _concat_runs([p[1] for p in parts])
+
+
+def _limit_chunk(b, f, S0, *, body, gains, ref, o, steps_per_period):
+    """(frame, runs) of :func:`limit_verdicts` for validated pairs (one chunk of them)."""
+    ntr, npr, blk, kmax = o["transient"], o["periods"], o["block"], o["max_period"]
+    runs = switched_runs(body, gains, ref, b, f, s0=S0, n_periods=ntr + npr,
                          lyapunov_from=ntr, steps_per_period=steps_per_period)
     T, N = runs.period, runs.states.shape[0]
     pmap = _SwitchedMap(body, gains, ref, runs.angle_limit, runs.force_limit, steps_per_period)

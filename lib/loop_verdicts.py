@@ -22,6 +22,7 @@ from .angles import wrap_angle
 from .closed_loop import ClosedLoop
 from .dynamics import verdicts as dv
 from .integrators import batch
+from .parallel import concat_frames, map_chunks
 from .params import Body, Gains
 from .trajectories import KINEMATICS
 
@@ -72,6 +73,13 @@ LOOP_VERDICT_DEFAULTS = MappingProxyType(dict(
     position_band=1e-3, position_tol=0.1, return_tol=0.05, d0=1e-7))
 
 
+def _lean(allocation, limits, w) -> bool:
+    """Whether :class:`_PeriodFlow` runs its lean field: the least-squares law without limits
+    and w_x w_y > 0 at every point of the call."""
+    return allocation == "least_squares" and limits.force is None and limits.angle is None \
+        and bool(np.all(w[:, 0] * w[:, 1] > 0))
+
+
 class _PeriodFlow:
     """The closed loop of N points in the normalised time tau = t / T_i (T_i = 2 pi / |Theta_i|
     the reference period), all points in lockstep: ``n`` classical RK4 steps per period, so
@@ -88,7 +96,7 @@ class _PeriodFlow:
     #: the heading's column in the error state (x, y, p, and rates): a :class:`lib.dynamics.verdicts.PeriodMap`
     turn_axis = 2
 
-    def __init__(self, body, gains, kinds, R, Theta, w, allocation, limits, n):
+    def __init__(self, body, gains, kinds, R, Theta, w, allocation, limits, n, lean=None):
         self.body, self.gains, self.kinds, self.n = body, gains, kinds, n
         self.R, self.Theta, self.w, self.allocation, self.limits = R, Theta, w, allocation, limits
         self.T = 2 * np.pi / np.abs(Theta)
@@ -100,8 +108,9 @@ class _PeriodFlow:
             table[r] = np.concatenate([z, dz, ddz], axis=-1)
         self.table = np.ascontiguousarray(table[:, :-1].transpose(1, 2, 0))     # (2n, 9, N): phase, component, point
         self.wind = table[:, -1, 2] - table[:, 0, 2]                            # heading advance per period (rad)
-        self.lean = allocation == "least_squares" and limits.force is None and limits.angle is None \
-            and bool(np.all(w[:, 0] * w[:, 1] > 0))
+        # ``lean`` given: decided once for all points of a call, so that a chunk of them
+        # (:func:`lib.parallel.map_chunks`) runs the same field as the whole call
+        self.lean = _lean(allocation, limits, w) if lean is None else bool(lean)
 
     def kin(self, idx):
         """The kinematics t -> (z_d, dz_d, ddz_d) of the rows ``idx`` (t (M,) in s)."""
@@ -242,7 +251,7 @@ def _loop_options(options: dict) -> dict:
 
 def closed_loop_verdicts(body: Body, gains: Gains, kind: str, R, Theta, weights=(1.0, 1.0, 0.0), *,
                          z0=None, dz0=None, allocation: str = "least_squares", limits: Limits | None = None,
-                         **options) -> pd.DataFrame:
+                         executor=None, chunk_size: int | None = None, **options) -> pd.DataFrame:
     """The verdict of Chapter 5 (:data:`lib.dynamics.verdicts.REGIMES`, and ``lost``) for the full
     six-state closed loop (2)-(4), (23) with the weighted allocation (weights (w_x, w_y, w_phi) per
     point; w_phi = 0 is exactly the paper's law (25)-(26)), on ``kind`` ("eight" (28) or "circle"
@@ -288,6 +297,13 @@ def closed_loop_verdicts(body: Body, gains: Gains, kind: str, R, Theta, weights=
     position_lost, tracked, residual, distance, turns_round, p_range (rad, over the last block),
     p_rms (rad, RMS of p wrapped to (-pi, pi], last block), pos_rms, pos_max (m, last block),
     periods, reason.
+
+    Scale-out: with an ``executor`` (any :class:`concurrent.futures.Executor`) the points go to
+    it in consecutive chunks of ``chunk_size`` (default: two chunks per worker; without an
+    executor, ``chunk_size`` runs the chunks here one after another), by
+    :func:`lib.parallel.map_chunks`. The field (lean or through :class:`ClosedLoop`) is chosen
+    once for all points of the call and every point is decided on its own, so the frame is
+    the one of the single call.
     """
     kinds = np.atleast_1d(np.asarray(kind, dtype=object))
     if kinds.ndim != 1 or kinds.size == 0:
@@ -300,7 +316,28 @@ def closed_loop_verdicts(body: Body, gains: Gains, kind: str, R, Theta, weights=
     except ValueError:
         raise ValueError(f"kind has {kinds.size} entries for {R.size} points") from None
     o = _loop_options(options)
-    flow = _PeriodFlow(body, gains, kinds, R, Theta, np.ascontiguousarray(w), allocation, limits, o["steps"])
+    N = R.size
+    starts = []
+    for name, v in (("z0", z0), ("dz0", dz0)):
+        if v is not None:
+            try:
+                v = np.broadcast_to(np.asarray(v, dtype=float), (N, 3))
+            except ValueError:
+                raise ValueError(f"{name} must have shape (3,) or ({N}, 3), got {np.shape(v)}") from None
+            if not np.all(np.isfinite(v)):
+                raise ValueError("the initial state z0, dz0 must be finite")
+        starts.append(v)
+    w = np.ascontiguousarray(w)
+    parts = map_chunks(_verdict_chunk, N, (kinds, R, Theta, w, *starts),
+                       dict(body=body, gains=gains, allocation=allocation, limits=limits, o=o,
+                            lean=_lean(allocation, limits, w)), executor, chunk_size)
+    return concat_frames(parts)
+
+
+def _verdict_chunk(kinds, R, Theta, w, z0, dz0, *, body, gains, allocation, limits, o, lean) -> pd.DataFrame:
+    """The frame of :func:`closed_loop_verdicts` for validated points (one chunk of them),
+    on the field ``lean`` chosen for the whole call."""
+    flow = _PeriodFlow(body, gains, kinds, R, Theta, w, allocation, limits, o["steps"], lean=lean)
     obs = _observe(flow, _start(flow, z0, dz0), o)
     out = _decide(flow, obs, w[:, 2] == 0, o)
     acc = obs["acc"]
@@ -434,7 +471,8 @@ def verdict_runs(body: Body, gains: Gains, runs: dict, **options) -> dict:
     integrator's cost is mostly per step, not per point, so one call is much cheaper than
     several). ``runs`` maps a name to a dict with ``kind``, ``R``, ``Theta`` and optionally
     ``weights`` ((3,) or (N, 3)), ``z0``, ``dz0`` ((3,) or (N, 3)); ``options`` go to
-    :func:`closed_loop_verdicts`. Returns the frames by name, each indexed from 0."""
+    :func:`closed_loop_verdicts` (``executor`` and ``chunk_size`` too: the points of all runs are
+    chunked together). Returns the frames by name, each indexed from 0."""
     if not runs:
         raise ValueError("no runs given")
     parts, sizes = [], []

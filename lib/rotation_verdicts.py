@@ -22,6 +22,7 @@ import pandas as pd
 from .angles import wrap_angle
 from .dynamics import verdicts as dv
 from .dynamics.orbits import floquet_multipliers
+from .parallel import concat_frames, map_chunks
 from .params import Body
 from .rotation import ENGINES, _check_grid, _initial
 from .rotation_engine import RotationMap, _Engine, orbit_range, verdict_steps
@@ -40,7 +41,8 @@ def eight_rotation_sweep(body: Body, R, Theta, **options) -> pd.DataFrame:
     range, started on the reference, for each pair (R_i (m), Theta_i (rad/s)): periodic,
     slipping, chaotic, quasiperiodic or undecided, decided by :func:`rotation_verdicts`
     (Newton on the period map of (32) and the largest Lyapunov exponent). See there for
-    the options and the columns (including ``lost``)."""
+    the options and the columns (including ``lost``), and for ``executor`` and ``chunk_size``
+    (the points in chunks through any :class:`concurrent.futures.Executor`)."""
     return rotation_verdicts(body, "eight", R, Theta, **options)
 
 
@@ -48,12 +50,13 @@ def eight_rotation_sweep(body: Body, R, Theta, **options) -> pd.DataFrame:
 FIG5_GRID = MappingProxyType(dict(R=(0.25, 4.0), Theta=(0.05, 1.5), n=100))
 
 
-def fig5_map(body: Body, n: int = FIG5_GRID["n"]) -> pd.DataFrame:
+def fig5_map(body: Body, n: int = FIG5_GRID["n"], *, executor=None, chunk_size: int | None = None) -> pd.DataFrame:
     """The book's Fig. 5 (Chapter 5, and the report's row on it): :func:`eight_rotation_sweep`
-    on the n x n grid :data:`FIG5_GRID`, Theta varying slowest."""
+    on the n x n grid :data:`FIG5_GRID`, Theta varying slowest; ``executor`` and
+    ``chunk_size`` as there (the same frame, computed elsewhere in chunks)."""
     n = _check_int("n", n, 2)
     R, Th = np.meshgrid(np.linspace(*FIG5_GRID["R"], n), np.linspace(*FIG5_GRID["Theta"], n))
-    return eight_rotation_sweep(body, R.ravel(), Th.ravel())
+    return eight_rotation_sweep(body, R.ravel(), Th.ravel(), executor=executor, chunk_size=chunk_size)
 
 
 def _check_body_kind(body, kind):
@@ -114,7 +117,8 @@ def _verdict_options(options: dict) -> dict:
 
 
 def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lambda: float = 0.125,
-                      steps: int | None = None, engine: str = "numba", **options) -> pd.DataFrame:
+                      steps: int | None = None, engine: str = "numba", executor=None,
+                      chunk_size: int | None = None, **options) -> pd.DataFrame:
     """Decisive verdict on the rotation error p = phi - phi_d of the reduced rotation
     equation (32) on the reference ``kind`` (``"eight"`` (28) or ``"circle"`` (27)) at each
     point (R_i (m), Theta_i (rad/s)), started on the reference with p(0) = ``p0`` (rad),
@@ -157,6 +161,13 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
 
     ``max_periods`` (option) caps the periods integrated per point (transient first).
 
+    Scale-out: with an ``executor`` (any :class:`concurrent.futures.Executor`, e.g.
+    :func:`lib.parallel.process_pool` or a dask ``Client.get_executor()``) the points go to it
+    in consecutive chunks of ``chunk_size`` (default: two chunks per worker) and the frames
+    come back in order (:func:`lib.parallel.map_chunks`); every point is decided on its own,
+    so the frame is the one of the single-process run. Without one, ``chunk_size`` runs the
+    chunks one after another here (bounding the memory of a large map).
+
     Returns a DataFrame, one row per point, in order: R (m), Theta (rad/s), regime;
     period (reference periods of the orbit, periodic/slipping; 0 otherwise); range (rad:
     max - min of p over the attracting orbit at every step (a slipping one over the k
@@ -192,11 +203,17 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
     if not (np.all(np.isfinite(p0)) and np.all(np.isfinite(v0))):
         raise ValueError("initial p0 and v0 must be finite")
     n_pts, n_fine = _step_counts(body, kind, R, Theta, h_lambda, steps, opts)
+    parts = map_chunks(_verdict_frame, N, (R, Theta, p0, v0, n_pts, n_fine),
+                       dict(body=body, kind=kind, opts=opts, engine=engine), executor, chunk_size)
+    return concat_frames(parts)
+
+
+def _verdict_frame(R, Theta, p0, v0, n_pts, n_fine, *, body, kind, opts, engine) -> pd.DataFrame:
+    """The frame of :func:`rotation_verdicts` for validated points (one chunk of them)."""
     res = _verdict_core(body, kind, R, Theta, p0, v0, n_pts, opts, engine, n_fine)
     cols = {k: v for k, v in res.items() if k not in ("x", "mult", "slip_n")}
     cols["turns_round"] = dv.turns_round(res["range"])
-    frame = pd.DataFrame({"R": R, "Theta": Theta, **cols, "steps": n_fine, "verdict_steps": n_pts})
-    return frame
+    return pd.DataFrame({"R": R, "Theta": Theta, **cols, "steps": n_fine, "verdict_steps": n_pts})
 
 
 def _step_counts(body, kind, R, Theta, h_lambda, steps, opts):
@@ -224,6 +241,17 @@ def _new_out(N: int) -> dict:
                 orbit_p=np.full(N, np.nan), distance=np.full(N, np.nan), residual=np.full(N, np.nan),
                 mirror=np.full(N, np.nan), periods=np.zeros(N, int), reason=np.full(N, "", dtype=object),
                 x=np.full((N, 2), np.nan), mult=np.full((N, 2), np.nan + 0j), slip_n=np.zeros(N, int))
+
+
+def _period_mean(logs: np.ndarray) -> np.ndarray:
+    """The mean over the periods (axis 0) of ``logs`` (P, M), summed period by period, so that
+    each point's mean does not depend on the other points in the batch (numpy's ``mean(axis=0)``
+    sums a single column pairwise, several columns in order: the last bit would depend on M,
+    and a sweep in chunks would differ from the sweep in one piece)."""
+    s = logs[0].copy()
+    for row in logs[1:]:
+        s += row
+    return s / logs.shape[0]
 
 
 class _Batch:
@@ -308,7 +336,7 @@ class _Batch:
         ly["J"] = o["J"]
         ly["lo"], ly["hi"] = np.minimum(ly["lo"], o["pmin"]), np.maximum(ly["hi"], o["pmax"])
         ly["pb"][:, b + 1] = self.s["phi"]
-        ly["logs"][:, b] = o["logs"].mean(axis=0)
+        ly["logs"][:, b] = _period_mean(o["logs"])
 
     def conclude(self, done, nb: int) -> None:
         """The rule (:func:`lib.dynamics.verdicts.classify`) for the rows ``done`` after ``nb``

@@ -21,7 +21,7 @@ from .closed_loop import ClosedLoop, reference_of
 from .integrators.smooth import integrate
 from .control import computed_torque, error_dynamics_solution
 from .limits import switched_runs
-from .parallel import map_in_processes
+from .parallel import concat_frames, map_chunks, map_in_processes
 from .params import Body, Gains
 from .simulate import Integration, SimulationResult, simulate
 from .trajectories import Reference, make
@@ -140,17 +140,30 @@ def refined_summary(body: Body, gains: Gains, res: SimulationResult, n_periods: 
 
 
 def eight_sensitivity(body: Body, gains: Gains, Rs, thetas, *, n_periods: float = 12.0,
-                      n_steady: float = 2.0, workers: int = 1) -> pd.DataFrame:
+                      n_steady: float = 2.0, workers: int = 1, executor=None,
+                      chunk_size: int | None = None) -> pd.DataFrame:
     """Steady-state measures of eight tracking (:func:`steady_summary`) over a grid of
     radii R (m) and rates theta (rad/s); one row per (R, theta). A run whose rotation
     does not settle to a periodic motion shows a large ``p_range``. The run's end state
     is returned too, so that a verdict can continue it: ``p_end`` (rad, in (-pi, pi]),
     ``dp_end`` (rad/s), the heading error and its rate, and ``e_end`` (m), the largest
     position error (the reduced rotation equation holds once it is negligible).
-    ``workers`` processes share the runs."""
+    ``workers`` spawned processes share the runs (:func:`lib.parallel.map_in_processes`);
+    or, with an ``executor`` (any :class:`concurrent.futures.Executor`, not with
+    ``workers`` > 1), the runs go to it in chunks of ``chunk_size``
+    (:func:`lib.parallel.map_chunks`). Each run is on its own: the same frame either way."""
     items = [(body, gains, float(R), float(th), n_periods, n_steady)
              for R in np.atleast_1d(Rs) for th in np.atleast_1d(thetas)]
-    return pd.DataFrame(map_in_processes(_sensitivity_one, items, workers))
+    if executor is None and chunk_size is None or not items:
+        return pd.DataFrame(map_in_processes(_sensitivity_one, items, workers))
+    if workers != 1:
+        raise ValueError(f"give workers (> 1) or an executor/chunk_size, not both (workers = {workers!r})")
+    parts = map_chunks(_sensitivity_chunk, len(items), (items,), None, executor, chunk_size)
+    return pd.DataFrame([row for part in parts for row in part])
+
+
+def _sensitivity_chunk(items) -> list:
+    return [_sensitivity_one(x) for x in items]
 
 
 def _sensitivity_one(args) -> dict:
@@ -180,7 +193,8 @@ def saturated_intervals(t, F, cap: float, rel: float = 1e-9) -> list[tuple[float
 
 
 def force_cap_sweep(body: Body, gains: Gains, ref: Reference, caps, *, n_periods: int = 10,
-                    n_steady: int = 2, samples_per_period: int = 400) -> pd.DataFrame:
+                    n_steady: int = 2, samples_per_period: int = 400, executor=None,
+                    chunk_size: int | None = None) -> pd.DataFrame:
     """Steady position-error amplitude (m) of tracking ``ref`` (the circle or the eight) with
     F <= cap and no angle limit, for each cap (N), from the paper's initial state.
 
@@ -188,13 +202,24 @@ def force_cap_sweep(body: Body, gains: Gains, ref: Reference, caps, *, n_periods
     which locates the cap's kinks), sampled ``samples_per_period`` times per period.
     Columns: ``cap``, ``pos_err_max`` (largest |(e_x, e_y)| over the last ``n_steady``
     periods), ``ex_amp``, ``ey_amp`` (half peak-to-peak of each component) and
-    ``sat_fraction`` (fraction of the samples at the cap).
+    ``sat_fraction`` (fraction of the samples at the cap). With an ``executor`` (any
+    :class:`concurrent.futures.Executor`) the caps go to it in chunks of ``chunk_size``
+    (:func:`lib.parallel.map_chunks`); each run is on its own: the same frame.
     """
     caps = np.atleast_1d(np.asarray(caps, dtype=float))
     if caps.ndim != 1 or caps.size == 0 or not np.all(np.isfinite(caps) & (caps > 0)):
         raise ValueError(f"caps must be positive finite forces (N), got {caps!r}")
     if not 0 < n_steady < n_periods:
         raise ValueError(f"need 0 < n_steady < n_periods, got {n_steady!r} and {n_periods!r}")
+    if not isinstance(body, Body) or not isinstance(gains, Gains):
+        raise TypeError("body and gains must be lib.params.Body and lib.params.Gains")
+    parts = map_chunks(_cap_chunk, caps.size, (caps,), dict(body=body, gains=gains, ref=ref, n_periods=n_periods,
+                       n_steady=n_steady, samples_per_period=samples_per_period), executor, chunk_size)
+    return concat_frames(parts)
+
+
+def _cap_chunk(caps, *, body, gains, ref, n_periods, n_steady, samples_per_period) -> pd.DataFrame:
+    """The rows of :func:`force_cap_sweep` for validated caps (one chunk of them)."""
     runs = switched_runs(body, gains, ref, np.pi, caps, n_periods=int(n_periods), samples_per_period=samples_per_period,
                          steps_per_period=samples_per_period)
     m = runs.t >= runs.t[-1] - n_steady * ref.period - 1e-9
