@@ -74,11 +74,20 @@ def test_fig5_in_chunks_here_is_the_map_in_one_piece(fig5_6x6):
     pd.testing.assert_frame_equal(eight_rotation_sweep(Body(), R, Th, chunk_size=5), whole, check_exact=True)
 
 
+def _one_point(R):
+    """A numba-parallel run in whichever process calls it: one Fig. 5 point."""
+    return eight_rotation_sweep(Body(), np.array([R]), np.array([0.5]), max_periods=16)
+
+
 def test_map_in_processes_and_a_pool_work_after_numba_has_run(fig5_6x6, pool):
-    # fig5_6x6 ran numba's parallel loops in this process: a fork now would abort
-    # ("fork() called from a process already using GNU OpenMP"); the pools spawn
+    # fig5_6x6 ran numba's parallel loops in this process: a forked child that runs them
+    # too aborts ("fork() called from a process already using GNU OpenMP, this is unsafe",
+    # BrokenProcessPool); the pools spawn
+    R = [1.0, 2.0]
+    here = concat_frames([_one_point(r) for r in R])
+    pd.testing.assert_frame_equal(concat_frames(map_in_processes(_one_point, R, 2)), here, check_exact=True)
+    pd.testing.assert_frame_equal(concat_frames(list(pool.map(_one_point, R))), here, check_exact=True)
     x = [0.5, 4.0, -7.0]
-    assert map_in_processes(wrap_angle, x, 2) == [wrap_angle(v) for v in x]
     assert list(pool.map(wrap_angle, x)) == [wrap_angle(v) for v in x]
     with pytest.raises(ValueError, match="workers"):
         map_in_processes(wrap_angle, x, 0)
