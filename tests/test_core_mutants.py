@@ -8,7 +8,10 @@ import math
 import numpy as np
 import pytest
 
+from lib import allocation as A, control, model, trajectories as T
+from lib.allocation import Allocation, Limits
 from lib.angles import state_difference, wrap_angle
+from lib.closed_loop import ClosedLoop, reference_of
 from lib.params import Body, Gains
 
 
@@ -59,11 +62,6 @@ def test_state_difference_works_on_batches_of_states_and_leaves_its_inputs_alone
 
 
 # ------------------------------------------------------------------ model
-
-from lib import model  # noqa: E402
-from lib.allocation import Allocation, Limits  # noqa: E402
-from lib.closed_loop import ClosedLoop, reference_of  # noqa: E402
-from lib import control, trajectories as T  # noqa: E402
 
 
 def test_printed_drift_is_the_derived_one_plus_twice_v1_omega_in_the_v2_row_numerically():
@@ -239,8 +237,6 @@ def test_error_dynamics_solution_keeps_the_shape_of_its_times():
 
 
 # ------------------------------------------------------------------ allocation
-
-from lib import allocation as A  # noqa: E402
 
 
 def test_allocation_weights_are_a_read_only_float_array():
