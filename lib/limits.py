@@ -481,18 +481,13 @@ def extend_undecided(body: Body, gains: Gains, ref: Reference, frame: pd.DataFra
     zero exponent where a chaotic one stays positive. Returns a copy of ``frame`` with
     those rows replaced and a column ``horizon`` (periods of section and Lyapunov run)."""
     o = {**LIMIT_DEFAULTS, **options}
-    out = frame.copy()
-    out["horizon"] = o["periods"]
-    todo = np.flatnonzero((frame.regime == "undecided").to_numpy())
-    if todo.size == 0:
-        return out
-    long = {**o, "periods": o["periods"] * factor, "block": o["block"] * factor}
-    redo, _ = limit_verdicts(body, gains, ref, frame.angle_limit.to_numpy()[todo],
-                             frame.force_limit.to_numpy()[todo], s0=s0, steps_per_period=steps_per_period, **long)
-    redo["horizon"] = long["periods"]
-    redo.index = frame.index[todo]
-    out.loc[redo.index, redo.columns] = redo
-    return out
+
+    def redo(rows, k):
+        long = {**o, "periods": o["periods"] * k, "block": o["block"] * k}
+        return limit_verdicts(body, gains, ref, frame.angle_limit.to_numpy()[rows], frame.force_limit.to_numpy()[rows],
+                              s0=s0, steps_per_period=steps_per_period, **long)[0]
+
+    return dv.redecide_undecided(frame, o["periods"], factor, redo)
 
 
 def regime_edges(frame: pd.DataFrame, regime: str = "chaotic") -> pd.DataFrame:

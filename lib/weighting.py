@@ -21,6 +21,7 @@ import pandas as pd
 from .allocation import Allocation, Limits
 from .angles import wrap_angle
 from .closed_loop import ClosedLoop
+from .dynamics import verdicts as dv
 from .dynamics.verdicts import REGIMES
 from .integrators import batch
 from .loop_verdicts import LOOP_VERDICT_DEFAULTS, _check_loop, _points, closed_loop_verdicts, held, verdict_runs
@@ -265,23 +266,19 @@ def extend_undecided(body: Body, gains: Gains, run: dict, frame: pd.DataFrame, f
     if isinstance(factor, bool) or not isinstance(factor, (int, np.integer)) or factor < 2:
         raise ValueError(f"factor must be an integer >= 2, got {factor!r}")
     o = {**LOOP_VERDICT_DEFAULTS, **options}
-    out = frame.copy()
-    out["horizon"] = o["periods"]
-    todo = np.flatnonzero((frame.regime == "undecided").to_numpy())
-    if todo.size == 0:
-        return out
     n = len(frame)
-    sub = {}
-    for key, v in run.items():
-        a = np.asarray(v, dtype=object if key == "kind" else float)
-        sub[key] = a[todo] if a.ndim >= 1 and a.shape[0] == n and key != "kind" and not (
-            key in ("z0", "dz0") and a.shape == (3,)) else v
-    longer = {**options, "periods": o["periods"] * factor, "block": o["block"] * factor}
-    redo = verdict_runs(body, gains, {"redo": sub}, **longer)["redo"]
-    redo["horizon"] = longer["periods"]
-    redo.index = frame.index[todo]
-    out.loc[redo.index, redo.columns] = redo
-    return out
+
+    def redo(rows, k):
+        sub = {}
+        for key, v in run.items():
+            a = np.asarray(v, dtype=object if key == "kind" else float)
+            per_point = a.ndim >= 1 and a.shape[0] == n and key != "kind" and not (
+                key in ("z0", "dz0") and a.shape == (3,))
+            sub[key] = a[rows] if per_point else v
+        longer = {**options, "periods": o["periods"] * k, "block": o["block"] * k}
+        return verdict_runs(body, gains, {"redo": sub}, **longer)["redo"]
+
+    return dv.redecide_undecided(frame, o["periods"], factor, redo)
 
 
 def refine_boundary(body: Body, gains: Gains, run: dict, w_phi, frame: pd.DataFrame, n: int = 7,

@@ -181,3 +181,22 @@ def test_the_circles_equilibrium_has_the_exponent_of_the_linearisation_34():
     assert frame.regime[0] == "periodic" and frame.period[0] == 1
     expected = circle_eigenvalues(BODY, R, theta).real.max()
     assert frame.lyapunov[0] == pytest.approx(expected, rel=1e-6)
+
+
+def test_undecided_rows_are_decided_again_and_keep_their_place():
+    import pandas as pd
+
+    frame = pd.DataFrame({"regime": ["periodic", "undecided", "chaotic", "undecided"], "x": [1, 2, 3, 4]},
+                         index=[10, 11, 12, 13])
+    seen = {}
+
+    def redo(rows, factor):
+        seen.update(rows=rows.tolist(), factor=factor)
+        return pd.DataFrame({"regime": ["periodic", "quasiperiodic"], "x": [20, 40]})
+
+    out = dv.redecide_undecided(frame, 120, 8, redo)
+    assert seen == {"rows": [1, 3], "factor": 8}
+    assert out.regime.tolist() == ["periodic", "periodic", "chaotic", "quasiperiodic"]
+    assert out.x.tolist() == [1, 20, 3, 40] and out.index.tolist() == [10, 11, 12, 13]
+    assert out.horizon.tolist() == [120, 960, 120, 960]
+    assert frame.regime.tolist()[1] == "undecided"            # the input is not changed
