@@ -48,6 +48,18 @@ ALWAYS = ["tests/test_core_mutants.py"]
 #: helpers the test files import
 SUPPORT = ["tests/conftest.py", "tests/flows.py"]
 
+#: appended to the copied tests/conftest.py: a test that runs slowly on a loaded machine must not
+#: fail hypothesis's 200 ms deadline (in the clean run that stops mutmut, in a mutant's run it
+#: would count as a kill)
+NO_DEADLINES = """
+
+# added by mutation/run.py
+from hypothesis import settings as _mutation_settings  # noqa: E402
+
+_mutation_settings.register_profile("mutation", deadline=None)
+_mutation_settings.load_profile("mutation")
+"""
+
 PYTEST_INI = """[tool:pytest]
 markers =
     book: builds the Jupyter Book (slow)
@@ -72,6 +84,8 @@ def _stage(work: Path, modules: list[str], debug: bool = False) -> list[str]:
     (work / "tests").mkdir()
     for t in {t.split("::")[0] for t in tests} | set(SUPPORT):
         shutil.copy2(ROOT / t, work / t)
+    with open(work / "tests" / "conftest.py", "a") as f:
+        f.write(NO_DEADLINES)
     (work / "setup.cfg").write_text(_config(modules, tests, debug))
     return tests
 
