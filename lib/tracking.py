@@ -168,7 +168,7 @@ def _sensitivity_chunk(items) -> list:
 
 def _sensitivity_one(args) -> dict:
     body, gains, R, th, n_periods, n_steady = args
-    res = run(body, gains, "eight", R, th, n_periods, samples_per_period=100,
+    res = run(body, gains, "eight", R, th, n_periods,
               integration=Integration(rtol=1e-9, atol=1e-9))
     return {"R": R, "theta": th, **steady_summary(res, n_steady),
             "p_end": float(wrap_angle(res.rotation_error()[-1])),
