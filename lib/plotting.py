@@ -299,3 +299,32 @@ def plot_limit_map(frame: pd.DataFrame, *, ax=None):
     ax.legend(handles=[Patch(color=LIMIT_COLORS[n], label=f"{n} ({counts[n]})") for n in names if n in counts],
               loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=5, fontsize=8)
     return fig
+
+
+def plot_bistable_window(theta, r_crit, r_edge, grid: pd.DataFrame, grid_r_crit, coexists,
+                         theta_close: float, mark=None, ax=None):
+    """The circle's bistable window over the rate: R_edge/R_crit - 1 (log scale) against
+    theta (rad/s), from ``theta``, ``r_crit``, ``r_edge`` (arrays, m) of
+    :func:`lib.circle_rotation.bistable_window`; over it the grid points of
+    :func:`circle_final_state` (``grid``, with R_crit per point ``grid_r_crit``) where a
+    slipping motion coexists (``coexists``, by simulation) or not; a dashed line at
+    ``theta_close`` and, if given, ``mark`` = (theta, R_edge/R_crit - 1) as a star."""
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(7, 4.5))
+    theta, excess = np.asarray(theta), np.asarray(r_edge) / np.asarray(r_crit) - 1.0
+    ax.semilogy(theta[excess > 0], excess[excess > 0], "k", lw=2,
+                label=r"$R_{edge}/R_{crit} - 1$ (homoclinic, shooting)")
+    g_excess = np.asarray(grid.R) / np.asarray(grid_r_crit) - 1.0
+    coexists = np.asarray(coexists, bool)
+    inside = (g_excess > 0) & (g_excess < 1.5)
+    ax.scatter(grid.theta[inside & coexists], g_excess[inside & coexists], s=40,
+               facecolors="none", edgecolors="C3", label="grid: slipping coexists")
+    ax.scatter(grid.theta[inside & ~coexists], g_excess[inside & ~coexists], s=10,
+               color="C0", marker=".", label="grid: settles only")
+    ax.axvline(theta_close, color="0.4", ls="--", lw=1,
+               label=r"$\theta$ where the window closes")
+    if mark is not None:
+        ax.plot(*mark, "*", color="C1", ms=12, label=r"the paper's $\theta = \pi/4$")
+    ax.set(xlabel=r"$\theta$ (rad/s)", ylabel=r"$R/R_{crit} - 1$", ylim=(1e-5, 2.0))
+    ax.legend(loc="lower right", fontsize=8)
+    return ax.figure
