@@ -287,3 +287,30 @@ def test_limited_allocation_does_not_admit_an_optimum_behind_the_body_of_unit_si
     for cap in (None, 3.0):
         F, beta = A.allocate_limited(np.array([-1.0, 0.0, 0.0]), 0.0, Body(), angle_limit=0.5, force_limit=cap)
         assert abs(beta) <= 0.5 and F == 0.0, (F, beta)
+
+
+def test_limits_are_stored_as_floats_and_name_the_limit_in_their_errors():
+    lim = Limits(force=3, angle=np.float32(0.5))
+    assert type(lim.force) is float and type(lim.angle) is float
+    with pytest.raises(ValueError, match=r"^force_limit must be a finite number in \(0, inf\], got -1"):
+        Limits(force=-1.0)
+    with pytest.raises(ValueError, match=r"^angle_limit must be a finite number in \(0, 3\.14"):
+        Limits(angle=4.0)
+
+
+@pytest.mark.parametrize("kw", [{"force": True}, {"angle": True}, {"force": np.array([3.0])},
+                                {"angle": [0.5]}, {"angle": np.array(0.5)[None]}])
+def test_limits_reject_a_bool_or_an_array(kw):
+    with pytest.raises(ValueError, match="_limit must be a finite number"):
+        Limits(**kw)
+
+
+def test_least_squares_allocation_broadcasts_one_demand_over_many_headings():
+    tau, phi = np.array([1.0, -0.5, 0.2]), np.linspace(-2.0, 2.0, 5)
+    F, beta = A.allocate_least_squares(tau, phi, Body(), (1.0, 1.0, 0.5))
+    assert F.shape == beta.shape == (5,)
+    for i in range(5):
+        Fi, bi = A.allocate_least_squares(tau, phi[i], Body(), (1.0, 1.0, 0.5))
+        assert F[i] == pytest.approx(float(Fi), rel=1e-14) and beta[i] == pytest.approx(float(bi), rel=1e-14)
+    with pytest.raises(TypeError, match=r"^body must be a lib\.params\.Body, got str$"):
+        A.allocate_least_squares(tau, 0.0, "body")
