@@ -47,8 +47,9 @@ benchmark: $(STAMP)
 clean:
 	rm -rf _build
 
-# Mutation testing of the core modules with mutmut, by hand (not in CI): about half an hour
-# on 2 cores, niced. Appends the score and the surviving mutants to mutation/REPORT.md.
+# Mutation testing of the core modules with mutmut, by hand (not in CI), niced: about 25 min
+# on 2 cores for all but allocation, about 40 min for allocation alone (MODULES=allocation).
+# Appends the score and the surviving mutants to mutation/REPORT.md.
 # MODULES="angles params" limits it to some of the seven.
 mutation: $(STAMP)
 	$(BIN)/python mutation/run.py $(MODULES)
