@@ -412,13 +412,6 @@ def _accumulate(acc: dict, zd, Y, b: int, last: bool) -> None:
         acc["posmax"] = np.fmax(acc["posmax"], e)
 
 
-def _rows(good, found, N: int) -> np.ndarray:
-    """(N,) bool: the rows ``good[found]``."""
-    m = np.zeros(N, bool)
-    m[good[found]] = True
-    return m
-
-
 def _decide(flow: _PeriodFlow, obs: dict, turns, o) -> dict:
     """The verdict columns from an observed run, by :mod:`lib.dynamics.verdicts`: the orbit
     reached (Newton with a difference Jacobian), else the rule on the exponent; the heading's
@@ -447,8 +440,9 @@ def _decide(flow: _PeriodFlow, obs: dict, turns, o) -> dict:
     drift, dse = dv.drift_statistics(hist[::Bk, :, 2].T, Bk, 2 * np.pi)
     pdrift, pse = dv.drift_statistics(acc["pos"] / acc["cnt"], Bk)
     out["pos_drift"], out["pos_drift_stderr"] = pdrift, pse
-    rest = np.zeros(N, bool)
-    rest[good[~f]] = True
+    orbit = np.zeros(N, bool)
+    orbit[g] = True
+    rest = finite & ~orbit
     returns = dv.section_returns(np.where(finite[None, :, None], hist[:, :, [2, 5]], 0.0))
     regime, reason = dv.classify(lam, se, returns, band=o["lyapunov_band"], return_tol=o["return_tol"],
                                  max_period=o["max_period"])
@@ -456,9 +450,9 @@ def _decide(flow: _PeriodFlow, obs: dict, turns, o) -> dict:
     out["lyapunov"][rest], out["lyapunov_stderr"][rest] = lam[rest] / T[rest], se[rest] / T[rest]
     out["slip"][rest], out["slip_stderr"][rest] = drift[rest], dse[rest]
     out["lost"][rest] = dv.heading_lost(False, 0, drift, dse, slip_band=o["slip_band"])[rest]
-    run_range = acc["pmax"] - acc["pmin"]
-    out["turns_round"] = dv.turns_round(np.where(_rows(good, f, N), acc["lmax"] - acc["lmin"], run_range))
-    out["position_lost"][rest] = ((pdrift > 3 * pse + o["position_band"]) | (acc["posmax"] > flow.R))[rest]
+    # the other reading: over the orbit (the last block) where there is one, over the run otherwise
+    out["turns_round"] = dv.turns_round(np.where(orbit, acc["lmax"] - acc["lmin"], acc["pmax"] - acc["pmin"]))
+    out["position_lost"][rest] = ((pdrift > dv.SIGMAS * pse + o["position_band"]) | (acc["posmax"] > flow.R))[rest]
     bad = ~finite
     out["reason"][bad] = "the state became non-finite (the run diverged)"
     out["lost"][bad] = out["position_lost"][bad] = True

@@ -7,7 +7,7 @@ the full closed loop under any allocation) supplies only that map and which of i
 coordinates is the heading, which may advance by whole turns; the steps below, and
 the words they decide, are written here once.
 
-The words (the book's definition ``def-verdicts``, Chapter 5):
+The words (the book's definition ``def-regimes``, Chapter 5):
 
 ``periodic``
     Newton on P^k(x) = x (k <= ``max_period``) converges, every Floquet multiplier
@@ -75,6 +75,14 @@ class PeriodMap(Protocol):
     def advance(self, idx: np.ndarray, x: np.ndarray, k) -> np.ndarray: ...
 
 
+def _less_whole_turns(d, turn_axis: int, allow):
+    """Differences of states ``d`` (M, d) with the heading's whole turns taken out where ``allow``
+    ((M,) bool) says so (in place); returns the turns n (M,) removed."""
+    n = np.where(allow, np.round(d[:, turn_axis] / TWO_PI), 0.0)
+    d[:, turn_axis] -= TWO_PI * n
+    return n
+
+
 def lag_candidates(hist, max_period: int, tol: float, *, turn_axis: int, turns=True, ends: int = 2):
     """Lags k <= ``max_period`` at which the section nearly repeats.
 
@@ -93,8 +101,7 @@ def lag_candidates(hist, max_period: int, tol: float, *, turn_axis: int, turns=T
         worst = np.zeros(N)
         for end in range(-1, -ends - 1, -1):
             d = hist[end] - hist[end - k]
-            n = np.where(allow, np.round(d[:, turn_axis] / TWO_PI), 0.0)
-            d[:, turn_axis] -= TWO_PI * n
+            n = _less_whole_turns(d, turn_axis, allow)
             worst = np.maximum(worst, np.abs(d).max(axis=1))
             if end == -1:
                 nn[k - 1] = n.astype(int)
@@ -125,8 +132,7 @@ def least_period(x, pts, k, n, *, turn_axis: int, turns=True, tol: float):
     allow = np.broadcast_to(np.asarray(turns, dtype=bool), (k.size,))
     for dv in range(int(k.max(initial=1)) - 1, 0, -1):
         dd = pts[dv - 1] - x
-        nd = np.where(allow, np.round(dd[:, turn_axis] / TWO_PI), 0.0)
-        dd[:, turn_axis] -= TWO_PI * nd
+        nd = _less_whole_turns(dd, turn_axis, allow)
         with np.errstate(invalid="ignore"):
             same = (k % dv == 0) & (dv < k) & (np.abs(dd).max(axis=1) <= tol)
         kmin[same], nmin[same] = dv, nd[same].astype(int)
