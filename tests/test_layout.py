@@ -12,7 +12,7 @@ LIB = Path(__file__).resolve().parents[1] / "lib"
 #: function-local imports of lib modules, each with the cost that justifies it
 LOCAL_IMPORTS_ALLOWED = {("lib.rotation", "lib.integrators.compiled"),               # numba's import and compile
                          ("lib.rotation_engine", "lib.integrators.compiled"),
-                         ("lib.limits", "lib.integrators.switched_compiled")}
+                         ("lib.switched_runs", "lib.integrators.switched_compiled")}
 
 
 def _module_name(path: Path) -> str:
