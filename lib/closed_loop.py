@@ -35,27 +35,34 @@ def reference_of(ref) -> Kinematics:
 class ClosedLoop:
     """s' = (dz, ddz) with ddz from (2)-(4) under the inputs (F, beta) that ``allocate``
     assigns to the demand (23) tracking ``kinematics``. Build it with :meth:`of`,
-    which validates the parts once; :meth:`rates` checks nothing, for loops."""
+    which validates the parts once; :meth:`rates` checks nothing, for loops.
+
+    ``body`` is the plant, integrated by (2)-(4); ``model`` the controller's own model
+    (the m, I_C, c, c_phi, a used by (23) and by the allocation), None for the plant's."""
 
     body: Body
     gains: Gains
     kinematics: Kinematics
     allocate: Allocator
+    model: Body | None = None
 
     @classmethod
     def of(cls, body: Body, gains: Gains, kinematics: Kinematics, allocation: Allocation | None = None,
-           limits: Limits | None = None) -> "ClosedLoop":
+           limits: Limits | None = None, model: Body | None = None) -> "ClosedLoop":
         if not isinstance(gains, Gains):
             raise TypeError(f"gains must be a lib.params.Gains, got {type(gains).__name__}")
         allocation = Allocation() if allocation is None else allocation
         if not isinstance(allocation, Allocation):
             raise TypeError(f"allocation must be a lib.allocation.Allocation, got {type(allocation).__name__}")
-        return cls(body, gains, kinematics, allocation.bind(body, limits))
+        if model is not None and not isinstance(model, Body):
+            raise TypeError(f"model must be a lib.params.Body or None, got {type(model).__name__}")
+        return cls(body, gains, kinematics, allocation.bind(body if model is None else model, limits), model)
 
     def inputs(self, t, z, dz):
         """(tau, F, beta): the demand (23) and the allocated force (N) and angle (rad)."""
         z_d, dz_d, ddz_d = self.kinematics(t)
-        tau = computed_torque_from(self.body, self.gains, z_d, dz_d, ddz_d, z, dz)
+        model = self.body if self.model is None else self.model
+        tau = computed_torque_from(model, self.gains, z_d, dz_d, ddz_d, z, dz)
         F, beta = self.allocate(tau, z[..., 2])
         return tau, F, beta
 

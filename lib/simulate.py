@@ -104,7 +104,7 @@ def _instance(name: str, value, cls):
 
 def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz0=None, *,
              limits: Limits | None = None, allocation: Allocation | None = None, t_eval=None,
-             integration: Integration | None = None) -> SimulationResult:
+             integration: Integration | None = None, model: Body | None = None) -> SimulationResult:
     """Integrate the closed loop (2)-(4), (23) with an allocation from t = 0 to ``t_end`` (s).
 
     ``z0``, ``dz0``: initial configuration and rate (default: the paper's Table,
@@ -114,7 +114,9 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
     ``t_eval``: output times (default: 20 per second). ``integration``: method,
     tolerances and switching (:class:`Integration`, default DOP853 at 1e-10). A
     state that blows up or becomes non-finite raises :class:`SimulationError`
-    naming the time and the variable.
+    naming the time and the variable. ``model``: the controller's model of the body
+    (the m, I_C, c, c_phi, a of (23) and of the allocation; default None, the plant
+    ``body`` itself); a model other than the plant needs ``switching="stepsize"``.
 
     With ``Integration(switching="events")`` the angle limit's switching surface
     is located (:class:`lib.integrators.switched.SwitchedLoop`): it needs an angle
@@ -134,17 +136,21 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
     limits = _instance("limits", limits, Limits)
     allocation = _instance("allocation", allocation, Allocation)
     integration = _instance("integration", integration, Integration)
+    if model is not None and not isinstance(model, Body):
+        raise TypeError(f"model must be a lib.params.Body or None, got {type(model).__name__}")
     if t_eval is None:
         t_eval = np.linspace(0.0, t_end, int(round(t_end * DEFAULT_RATE)) + 1)
     t_eval = np.asarray(t_eval, dtype=float)
     if t_eval.ndim != 1 or t_eval.size == 0 or t_eval[0] < 0 or t_eval[-1] > t_end or np.any(np.diff(t_eval) <= 0):
         raise ValueError("t_eval must be a non-empty increasing 1-D array within [0, t_end]")
     if integration.switching == "events":
+        if model is not None and model != body:
+            raise ValueError("switching='events' runs the plant's own model; give model=None")
         if allocation.law != "position":
             raise ValueError("switching='events' supports the position-only allocation only")
         return _simulate_events(body, gains, ref, t_end, z0, dz0, limits, t_eval, integration)
 
-    loop = ClosedLoop.of(body, gains, reference_of(ref), allocation, limits)
+    loop = ClosedLoop.of(body, gains, reference_of(ref), allocation, limits, model)
 
     def rhs(t: float, s: np.ndarray) -> np.ndarray:
         out = loop.rates(t, s)[0]
