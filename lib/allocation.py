@@ -20,6 +20,7 @@ from typing import Callable
 
 import numpy as np
 
+from . import checks
 from .angles import wrap_angle
 from .model import input_matrix
 from .params import Body
@@ -28,10 +29,8 @@ __all__ = ["Limits", "Allocation", "LAWS", "allocate", "allocate_least_squares",
            "least_squares_problem"]
 
 
-def _check_limit(name: str, value, upper: float) -> float:
-    if isinstance(value, bool) or not np.isscalar(value) or not np.isfinite(value) or not 0 < value <= upper:
-        raise ValueError(f"{name} must be a finite number in (0, {upper}], got {value!r}")
-    return float(value)
+def _check_limit(name: str, value, upper: float | None) -> float:
+    return checks.number(name, value, positive=True, maximum=upper)
 
 
 @dataclass(frozen=True)
@@ -45,7 +44,7 @@ class Limits:
 
     def __post_init__(self) -> None:
         if self.force is not None:
-            object.__setattr__(self, "force", _check_limit("force_limit", self.force, upper=np.inf))
+            object.__setattr__(self, "force", _check_limit("force_limit", self.force, upper=None))
         if self.angle is not None:
             object.__setattr__(self, "angle", _check_limit("angle_limit", self.angle, upper=np.pi))
 
@@ -93,14 +92,14 @@ def _position(tau, phi, limits: Limits):
 
 
 def _check_weights(weights) -> np.ndarray:
-    w = np.asarray(weights, dtype=float)
-    if w.ndim == 0 or w.shape[-1] != 3 or not np.all(np.isfinite(w)) or np.any(w < 0) or not np.all(np.any(w > 0, -1)):
-        raise ValueError(f"weights must be three finite non-negative numbers, not all zero, got {weights!r}")
+    w = np.array(checks.array("weights", weights, shape=(..., 3), nonnegative=True), dtype=float)
+    if not np.all(np.any(w > 0, -1)):
+        raise ValueError(f"weights (w_x, w_y, w_phi) must be non-negative and not all zero, got {weights!r}")
     return w
 
 
 def _check_tau(tau, n=(3,)) -> np.ndarray:
-    tau = np.asarray(tau, dtype=float)
+    tau = np.asarray(tau) if isinstance(tau, np.ndarray) and tau.dtype.kind == "f" else checks.array("tau", tau, finite=False)
     if tau.ndim == 0 or tau.shape[-1] not in n:
         names = "3 (tau_x, tau_y, tau_phi)" if n == (3,) else "2 or 3"
         raise ValueError(f"tau must have a last axis of length {names}, got shape {tau.shape}")
@@ -108,9 +107,7 @@ def _check_tau(tau, n=(3,)) -> np.ndarray:
 
 
 def _checked_body(body) -> Body:
-    if not isinstance(body, Body):
-        raise TypeError(f"body must be a lib.params.Body, got {type(body).__name__}")
-    return body
+    return checks.instance("body", body, Body)
 
 
 def least_squares_problem(tau, phi, body: Body, weights):

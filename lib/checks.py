@@ -181,11 +181,11 @@ def array(name: str, value: Any, *, shape: tuple | None = None, finite: bool = T
     bad = np.isnan(arr) | (~np.isfinite(arr) if finite else False)
     if np.any(bad):
         i = _first_bad(bad)
-        raise ValueError(f"{name}{i} must be finite, got {arr[tuple(np.argwhere(bad)[0])]!r}")
+        raise ValueError(f"{name}{i} must be finite, got {float(arr[tuple(np.argwhere(bad)[0])])!r}")
     for flag_, cond, word in ((positive, arr > 0, "positive"), (nonnegative, arr >= 0, "non-negative")):
         if flag_ and not np.all(cond):
             j = np.argwhere(~cond)[0]
-            raise ValueError(f"{name}{_first_bad(~cond)} must be {word}, got {arr[tuple(j)]!r}")
+            raise ValueError(f"{name}{_first_bad(~cond)} must be {word}, got {float(arr[tuple(j)])!r}")
     return arr
 
 

@@ -1,7 +1,9 @@
 """Physical and feedback parameters (the paper's Table 1, printed as "Table 5").
 
-Both classes are frozen dataclasses validated on construction: a non-positive
-or non-finite value raises :class:`ValueError` naming the offending field.
+Both classes are frozen dataclasses validated on construction (by
+:mod:`lib.checks`): a non-positive or non-finite value raises :class:`ValueError`
+and a value that is not a real number (a str, a bool) raises :class:`TypeError`,
+both naming the offending field (and the axis index for a gain).
 """
 
 from __future__ import annotations
@@ -11,20 +13,14 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
+from . import checks
+
 __all__ = ["Body", "Gains", "PAPER_Z0", "PAPER_DZ0"]
 
 #: Initial configuration of the paper's Table: x = 1 m, y = 0 m, phi = pi/2 rad.
 PAPER_Z0 = (1.0, 0.0, math.pi / 2)
 #: Initial velocities of the paper's Table: the body starts at rest.
 PAPER_DZ0 = (0.0, 0.0, 0.0)
-
-
-def _check_positive(owner: str, name: str, value) -> None:
-    arr = np.asarray(value, dtype=float)
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{owner}.{name} must be finite, got {value!r}")
-    if not np.all(arr > 0):
-        raise ValueError(f"{owner}.{name} must be positive, got {value!r}")
 
 
 @dataclass(frozen=True)
@@ -48,11 +44,8 @@ class Body:
 
     def __post_init__(self) -> None:
         for f in fields(self):
-            value = getattr(self, f.name)
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-                raise ValueError(f"Body.{f.name} must be a real number, got {value!r}")
-            _check_positive("Body", f.name, value)
-            object.__setattr__(self, f.name, float(value))
+            value = checks.number(f"Body.{f.name}", getattr(self, f.name), positive=True)
+            object.__setattr__(self, f.name, value)
 
     @property
     def mass_matrix(self) -> np.ndarray:
@@ -66,12 +59,13 @@ class Body:
 
 
 def _as_gain(owner: str, name: str, value) -> np.ndarray:
-    arr = np.asarray(value, dtype=float)
-    if arr.ndim == 0:
-        arr = np.full(3, float(arr))
-    if arr.shape != (3,):
-        raise ValueError(f"{owner}.{name} must be a scalar or have length 3 (x, y, phi), got shape {arr.shape}")
-    _check_positive(owner, name, arr)
+    if np.ndim(value) == 0:
+        arr = np.full(3, checks.number(f"{owner}.{name}", value, positive=True))
+    else:
+        arr = np.array(checks.array(f"{owner}.{name}", value), dtype=float)
+        if arr.shape != (3,):
+            raise ValueError(f"{owner}.{name} must be a scalar or have length 3 (x, y, phi), got shape {arr.shape}")
+        checks.array(f"{owner}.{name}", arr, positive=True)
     arr.setflags(write=False)
     return arr
 

@@ -12,20 +12,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import checks
+
 __all__ = ["Reference", "Circle", "Eight", "circle", "eight", "make", "NAMES", "circle_kinematics",
            "eight_kinematics", "KINEMATICS", "circle_position", "eight_position", "position_kinematics", "POSITIONS",
            "eight_heading_fourier", "heading_series", "PAPER_HEADING_SERIES"]
 
 
 def _check_shape(R: float, theta: float) -> tuple[float, float]:
-    for name, v in (("R", R), ("theta", theta)):
-        if isinstance(v, bool) or not np.isscalar(v) or not np.isfinite(v):
-            raise ValueError(f"trajectory parameter {name} must be a finite real number, got {v!r}")
-    if R <= 0:
-        raise ValueError(f"trajectory radius R must be positive, got {R!r}")
+    R = checks.number("trajectory radius R", R, positive=True, unit="m")
+    theta = checks.number("trajectory angular rate theta", theta, unit="rad/s")
     if theta == 0:
         raise ValueError("trajectory angular rate theta must be non-zero (theta = 0 is a standstill)")
-    return float(R), float(theta)
+    return R, theta
 
 
 class Reference:
@@ -230,8 +229,8 @@ def eight_heading_fourier(n_harmonics: int = 9, n_samples: int = 4096) -> np.nda
 
     phi_d is even in s, so phi_d = a_0 + sum_k a_k cos(k s); the half-period
     symmetry phi_d(s + pi) - pi = -(phi_d(s) - pi) leaves only odd k."""
-    if not isinstance(n_harmonics, (int, np.integer)) or n_harmonics < 0:
-        raise ValueError(f"n_harmonics must be a non-negative integer, got {n_harmonics!r}")
+    n_harmonics = checks.integer("n_harmonics", n_harmonics, minimum=0)
+    n_samples = checks.integer("n_samples", n_samples, minimum=2 * n_harmonics + 2)
     s = 2 * np.pi * np.arange(n_samples) / n_samples
     H = eight_kinematics(1.0, 1.0, s)[0][..., 2]
     c = np.fft.rfft(H) / n_samples

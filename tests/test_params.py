@@ -23,7 +23,7 @@ def test_body_rejects_non_positive_or_non_finite_values_naming_the_field(field, 
 
 @pytest.mark.parametrize("value", ["2", None, True])
 def test_body_rejects_non_numbers(value):
-    with pytest.raises(ValueError, match=r"Body\.m"):
+    with pytest.raises(TypeError, match=r"Body\.m"):
         Body(m=value)
 
 
