@@ -26,7 +26,7 @@ from .parallel import concat_frames, map_chunks
 from .params import Body, Gains
 from .trajectories import KINEMATICS
 
-__all__ = ["LOOP_VERDICT_DEFAULTS", "closed_loop_verdicts", "verdict_runs", "held"]
+__all__ = ["LOOP_VERDICT_DEFAULTS", "closed_loop_verdicts", "held"]
 
 
 def _points(R, Theta, weights):
@@ -458,37 +458,6 @@ def _decide(flow: _PeriodFlow, obs: dict, turns, o) -> dict:
     out["lost"][bad] = out["position_lost"][bad] = True
     out["tracked"] = ~out["position_lost"] & (acc["posmax"] <= o["position_tol"] * flow.R)
     return out
-
-
-def verdict_runs(body: Body, gains: Gains, runs: dict, **options) -> dict:
-    """Several sets of points through ONE call of :func:`closed_loop_verdicts` (the batch
-    integrator's cost is mostly per step, not per point, so one call is much cheaper than
-    several). ``runs`` maps a name to a dict with ``kind``, ``R``, ``Theta`` and optionally
-    ``weights`` ((3,) or (N, 3)), ``z0``, ``dz0`` ((3,) or (N, 3)); ``options`` go to
-    :func:`closed_loop_verdicts` (``executor`` and ``chunk_size`` too: the points of all runs are
-    chunked together). Returns the frames by name, each indexed from 0."""
-    if not runs:
-        raise ValueError("no runs given")
-    parts, sizes = [], []
-    for name, r in runs.items():
-        unknown = set(r) - {"kind", "R", "Theta", "weights", "z0", "dz0"}
-        if unknown or not {"kind", "R", "Theta"} <= set(r):
-            raise ValueError(f"run {name!r} needs kind, R, Theta (and optionally weights, z0, dz0); "
-                             f"unknown keys {sorted(unknown)}")
-        R, Theta, w = _points(r["R"], r["Theta"], r.get("weights", (1.0, 1.0, 0.0)))
-        ref = [np.concatenate(KINEMATICS[r["kind"]](R, Theta, 0.0)[:2], axis=1)] if r["kind"] in KINEMATICS else None
-        if ref is None:
-            raise ValueError(f"unknown trajectory {r['kind']!r} in run {name!r}; known: {sorted(KINEMATICS)}")
-        s0 = ref[0]
-        for key, sl in (("z0", slice(0, 3)), ("dz0", slice(3, 6))):
-            if r.get(key) is not None:
-                s0[:, sl] = np.broadcast_to(np.asarray(r[key], dtype=float), (R.size, 3))
-        parts.append((np.full(R.size, r["kind"], dtype=object), R, Theta, w, s0))
-        sizes.append(R.size)
-    kinds, R, Theta, w, s0 = (np.concatenate([p[i] for p in parts]) for i in range(5))
-    frame = closed_loop_verdicts(body, gains, kinds, R, Theta, w, z0=s0[:, :3], dz0=s0[:, 3:], **options)
-    edges = np.cumsum([0] + sizes)
-    return {name: frame.iloc[a:b].reset_index(drop=True) for name, a, b in zip(runs, edges[:-1], edges[1:])}
 
 
 def held(frame: pd.DataFrame) -> np.ndarray:

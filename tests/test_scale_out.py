@@ -13,6 +13,7 @@ import pytest
 
 from lib import limits as L
 from lib import loop_verdicts as LV
+from lib import weighting as W
 from lib import trajectories as T
 from lib.allocation import Limits
 from lib.angles import wrap_angle
@@ -134,8 +135,8 @@ def test_closed_loop_verdicts_through_a_process_pool_are_the_single_call(pool):
                                   LV.closed_loop_verdicts(Body(), Gains(), "eight", **lim, **SHORT), check_exact=True)
     runs = {"a": dict(kind="eight", R=POINTS["R"][:2], Theta=POINTS["Theta"][:2]),
             "b": dict(kind="circle", R=1.0, Theta=0.5)}
-    one, chunked = LV.verdict_runs(Body(), Gains(), runs, **SHORT), \
-        LV.verdict_runs(Body(), Gains(), runs, chunk_size=2, **SHORT)
+    one, chunked = W.verdict_runs(Body(), Gains(), runs, **SHORT), \
+        W.verdict_runs(Body(), Gains(), runs, chunk_size=2, **SHORT)
     for name in runs:
         pd.testing.assert_frame_equal(chunked[name], one[name], check_exact=True)
 
