@@ -1,6 +1,7 @@
 """Tracking results of paper Secs. 4-5: the runs behind Figs. 2-4 and the
 numbers the chapters quote (steady rotation error, position-error deviation
-from the analytic solution of (24), force needed, error left by a force cap).
+from the analytic solution of (24), force needed, error left by a force cap); and
+(re-exported from :mod:`lib.mismatch`) tracking with a wrong model, :func:`mismatch_sweep`.
 
 Every function takes its parameters explicitly and returns plain numbers,
 arrays or DataFrames; the figures are drawn by :mod:`lib.plotting`.
@@ -21,6 +22,7 @@ from .closed_loop import ClosedLoop, reference_of
 from .integrators.smooth import integrate
 from .control import computed_torque, error_dynamics_solution
 from .limits import switched_runs
+from .mismatch import mismatch_sweep
 from .parallel import concat_frames, map_chunks, map_in_processes
 from .params import Body, Gains
 from .simulate import Integration, SimulationResult, simulate
@@ -29,7 +31,7 @@ from .trajectories import Reference, make
 __all__ = [
     "run", "steady_mask", "restrict", "rotation_error_continuous", "position_deviation_from_eq24",
     "steady_summary", "refined_summary", "eight_sensitivity", "force_cap_sweep", "saturated_intervals",
-    "circle_rotation_equilibrium",
+    "circle_rotation_equilibrium", "mismatch_sweep",
 ]
 
 
