@@ -224,6 +224,124 @@ def _hermite_root(P, lim, mode, t, dt, s, f0, y1, f1, g0, ev, yh, fh, gh):
 
 
 @numba.njit(cache=True)
+def _first_fired(mode, g0, g1):
+    """The first event (in the order of the event functions) that fired between g0 and g1, or -1."""
+    for k in range(N_EVENTS):
+        if _fired(mode, g0, g1, k):
+            return k
+    return -1
+
+
+@numba.njit(cache=True)
+def _locate(P, lim, mode, t, s, dt, first, A, b, c, K, ys, y1, y2, g0, g1, g2, yh, fh, gh, stats):
+    """The time from t (s) to the first event within a step dt from state s, where the event
+    ``first`` fired at the step's end (y1, g1): bracketed to _T_TOL. Returns it; y2, g2 hold
+    the state and event functions at the bracket's end."""
+    # bracket the first event in (lo, hi]
+    lo, hi = 0.0, dt
+    ev = first
+    glo, ghi = g0[ev], g1[ev]
+    _copy(y1, g1, y2, g2)
+    # first on the step's cubic Hermite interpolant (one field evaluation per try), then
+    # two real steps a little before and after its root narrow the bracket cheaply
+    guess = _hermite_root(P, lim, mode, t, dt, s, K[0], y1, ys, g0, ev, yh, fh, gh)
+    if 0.0 < guess < dt:
+        for th in (guess - 1e-3 * dt, guess + 1e-3 * dt):
+            if not lo < th < hi:
+                continue
+            _step(P, lim, mode, t, s, th, A, b, c, K, ys, y1, g1)
+            stats[5] += 1
+            hit = _first_fired(mode, g0, g1)
+            if hit >= 0:
+                hi = th
+                _copy(y1, g1, y2, g2)
+                if hit != ev:
+                    ev = hit
+                    glo = g0[ev]
+                ghi = g1[ev]
+                break
+            lo = th
+            glo = g1[ev]
+    # then Illinois on the target event with real steps (a bisection when it stalls); a
+    # secant try that lands next to the root is followed by a try just across it, 0.9 tol
+    # away, which closes the bracket at once when the secant was accurate
+    side = 0
+    it = 0
+    stall = 0
+    nudge = 0
+    while hi - lo > _T_TOL and it < 200:
+        it += 1
+        width = hi - lo
+        secant = False
+        if nudge == 1:
+            th = lo + 0.9 * _T_TOL
+        elif nudge == -1:
+            th = hi - 0.9 * _T_TOL
+        elif stall >= 2 or ghi == glo:
+            th = 0.5 * (lo + hi)
+            stall = 0
+        else:
+            th = (lo * ghi - hi * glo) / (ghi - glo)
+            secant = True
+            if not (lo < th < hi):
+                th = 0.5 * (lo + hi)
+                secant = False
+        _step(P, lim, mode, t, s, th, A, b, c, K, ys, y1, g1)
+        stats[5] += 1
+        hit = -1
+        for k in range(N_EVENTS):
+            if _fired(mode, g0, g1, k):
+                hit = k
+                if k == ev:
+                    break
+        if hit >= 0:  # an event before th
+            hi = th
+            _copy(y1, g1, y2, g2)
+            if hit != ev:  # another event comes first: follow it from here on
+                ev = hit
+                side = 0
+                glo = g0[ev]
+            ghi = g1[ev]
+            if side == 1:
+                glo *= 0.5
+            side = 1
+            nudge = -1 if secant else 0
+        else:
+            lo = th
+            glo = g1[ev]
+            if side == -1:
+                ghi *= 0.5
+            side = -1
+            nudge = 1 if secant else 0
+        stall = stall + 1 if hi - lo > 0.5 * width else 0
+    return hi
+
+
+@numba.njit(cache=True)
+def _new_mode(P, lim, mode, t, s, g0, g2, stats):
+    """The mode after an event at time t (s), state s: the event that fired at the landing
+    point decides (the switching and exit events take precedence)."""
+    ev = _first_fired(mode, g0, g2)
+    if mode != 0 and ev == 0:
+        lon, rp, rm = _one_sided(P, lim, t, s)
+        far = rm if mode == 1 else rp
+        near = rp if mode == 1 else rm
+        if lon >= 0 or mode * far < 0:
+            if lon < 0:
+                stats[0] += 1
+            return -mode
+        if mode * near < 0:
+            stats[1] += 1
+            return 0
+        return mode  # a grazing touch, both fields carry the run back: keep the mode
+    if mode == 0 and ev == 0:
+        return 1
+    if mode == 0 and ev == 1:
+        return -1
+    return mode
+
+
+@numba.njit(cache=True)
 def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2, yh, fh, gh, stats):
     """Integrate s (in place) over n_steps steps of size h from t0; returns the final mode.
     stats: [crossings, slides, time sliding, events, failed, steps locating events]."""
@@ -237,98 +355,14 @@ def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2
             if dt <= 1e-13 * (1.0 + abs(t_end)):
                 break
             _step(P, lim, mode, t, s, dt, A, b, c, K, ys, y1, g1)
-            first = -1
-            for k in range(N_EVENTS):
-                if _fired(mode, g0, g1, k):
-                    first = k
-                    break
+            first = _first_fired(mode, g0, g1)
             if first < 0:
                 if mode == 0:
                     stats[2] += dt
                 _copy(y1, g1, s, g0)
                 t = t_end
                 break
-            # bracket the first event in (lo, hi]
-            lo, hi = 0.0, dt
-            ev = first
-            glo, ghi = g0[ev], g1[ev]
-            _copy(y1, g1, y2, g2)
-            # first on the step's cubic Hermite interpolant (one field evaluation per try), then
-            # two real steps a little before and after its root narrow the bracket cheaply
-            guess = _hermite_root(P, lim, mode, t, dt, s, K[0], y1, ys, g0, ev, yh, fh, gh)
-            if 0.0 < guess < dt:
-                for th in (guess - 1e-3 * dt, guess + 1e-3 * dt):
-                    if not lo < th < hi:
-                        continue
-                    _step(P, lim, mode, t, s, th, A, b, c, K, ys, y1, g1)
-                    stats[5] += 1
-                    hit = -1
-                    for k in range(N_EVENTS):
-                        if _fired(mode, g0, g1, k):
-                            hit = k
-                            break
-                    if hit >= 0:
-                        hi = th
-                        _copy(y1, g1, y2, g2)
-                        if hit != ev:
-                            ev = hit
-                            glo = g0[ev]
-                        ghi = g1[ev]
-                        break
-                    lo = th
-                    glo = g1[ev]
-            # then Illinois on the target event with real steps (a bisection when it stalls); a
-            # secant try that lands next to the root is followed by a try just across it, 0.9 tol
-            # away, which closes the bracket at once when the secant was accurate
-            side = 0
-            it = 0
-            stall = 0
-            nudge = 0
-            while hi - lo > _T_TOL and it < 200:
-                it += 1
-                width = hi - lo
-                secant = False
-                if nudge == 1:
-                    th = lo + 0.9 * _T_TOL
-                elif nudge == -1:
-                    th = hi - 0.9 * _T_TOL
-                elif stall >= 2 or ghi == glo:
-                    th = 0.5 * (lo + hi)
-                    stall = 0
-                else:
-                    th = (lo * ghi - hi * glo) / (ghi - glo)
-                    secant = True
-                    if not (lo < th < hi):
-                        th = 0.5 * (lo + hi)
-                        secant = False
-                _step(P, lim, mode, t, s, th, A, b, c, K, ys, y1, g1)
-                stats[5] += 1
-                hit = -1
-                for k in range(N_EVENTS):
-                    if _fired(mode, g0, g1, k):
-                        hit = k
-                        if k == ev:
-                            break
-                if hit >= 0:  # an event before th
-                    hi = th
-                    _copy(y1, g1, y2, g2)
-                    if hit != ev:  # another event comes first: follow it from here on
-                        ev = hit
-                        side = 0
-                        glo = g0[ev]
-                    ghi = g1[ev]
-                    if side == 1:
-                        glo *= 0.5
-                    side = 1
-                    nudge = -1 if secant else 0
-                else:
-                    lo = th
-                    glo = g1[ev]
-                    if side == -1:
-                        ghi *= 0.5
-                    side = -1
-                    nudge = 1 if secant else 0
-                stall = stall + 1 if hi - lo > 0.5 * width else 0
+            hi = _locate(P, lim, mode, t, s, dt, first, A, b, c, K, ys, y1, y2, g0, g1, g2, yh, fh, gh, stats)
             if mode == 0:
                 stats[2] += hi
             t += hi
@@ -339,28 +373,7 @@ def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2
             if n_ev > _MAX_EVENTS_PER_STEP:
                 stats[4] = 1.0
                 return mode
-            # the event that fired at the landing point (the switching/exit events take precedence)
-            ev = -1
-            for k in range(N_EVENTS):
-                if _fired(mode, g0, g2, k):
-                    ev = k
-                    break
-            if mode != 0 and ev == 0:
-                lon, rp, rm = _one_sided(P, lim, t, s)
-                far = rm if mode == 1 else rp
-                near = rp if mode == 1 else rm
-                if lon >= 0 or mode * far < 0:
-                    mode = -mode
-                    if lon < 0:
-                        stats[0] += 1
-                elif mode * near < 0:
-                    mode = 0
-                    stats[1] += 1
-                # else: a grazing touch, both fields carry the run back: keep the mode
-            elif mode == 0 and ev == 0:
-                mode = 1
-            elif mode == 0 and ev == 1:
-                mode = -1
+            mode = _new_mode(P, lim, mode, t, s, g0, g2, stats)
             _field(P, lim, mode, t, s, ys, g0)
         for q in range(6):
             if not math.isfinite(s[q]):
