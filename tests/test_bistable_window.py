@@ -46,7 +46,7 @@ def test_edge_separates_running_from_settling(theta):
     drift, _, _ = _long_run(BODY, r_edge * (1 - 1e-3), theta)
     assert drift < -10 * 2 * math.pi
     drift, gap, speed = _long_run(BODY, r_edge * (1 + 1e-3), theta)
-    assert abs(drift) < 1e-6 and gap < 1e-6 and speed < 1e-6
+    assert abs(drift) < 2e-11 and gap < 2e-12 and speed < 2e-12  # measured 2.1e-12, 1.6e-13, 1.4e-13
 
 
 def test_edge_is_the_normalised_pendulums_homoclinic():
@@ -57,7 +57,7 @@ def test_edge_is_the_normalised_pendulums_homoclinic():
     r_crit, r_edge = bistable_window(BODY, theta)
     k = r_crit / r_edge
     alpha = _damping_at_rcrit(BODY, theta) * math.sqrt(k)
-    assert torque_pendulum_threshold(k) == pytest.approx(alpha, rel=1e-8)
+    assert torque_pendulum_threshold(k) == pytest.approx(alpha, rel=3e-10)  # measured 3.2e-11
 
 
 def test_no_window_at_strong_damping():
@@ -73,8 +73,8 @@ def test_window_closes_where_damping_crosses_pendulum_threshold():
     and 2 % either side of that Theta the window is open above, closed below."""
     theta_close = window_closing_rate(BODY)
     alpha_c = torque_pendulum_threshold()
-    assert _damping_at_rcrit(BODY, theta_close) == pytest.approx(alpha_c, rel=1e-5)
-    assert alpha_c == pytest.approx(1.19, abs=0.01)
+    assert _damping_at_rcrit(BODY, theta_close) == pytest.approx(alpha_c, rel=1e-5)  # measured 5.0e-7: the two thresholds are computed apart, each to 1e-5
+    assert alpha_c == pytest.approx(1.19, abs=0.01)  # measured 2.0e-3; reason: 1.19 is the classical value to two decimals
     r_crit, r_edge = bistable_window(BODY, 1.02 * theta_close)
     assert r_edge > r_crit
     r_crit, r_edge = bistable_window(BODY, theta_close / 1.02)
@@ -84,13 +84,14 @@ def test_window_closes_where_damping_crosses_pendulum_threshold():
 def test_threshold_meets_melnikov_for_weak_torque():
     """For small torque k the homoclinic damping is pi k/4 (Melnikov; Strogatz 2015,
     Sec. 8.5): at k = 0.02 to 1e-3 relative."""
-    assert torque_pendulum_threshold(0.02) == pytest.approx(math.pi * 0.02 / 4, rel=1e-3)
+    assert torque_pendulum_threshold(0.02) == pytest.approx(math.pi * 0.02 / 4, rel=6e-4)  # measured 6.1e-5; Melnikov holds to O(k^2)
 
 
-@pytest.mark.parametrize("theta", [0.0, -1.0, math.nan, math.inf, True, "1", None,
-                                   np.array([1.0])])
-def test_bistable_window_rejects_bad_rates(theta):
-    with pytest.raises(ValueError, match="Theta"):
+@pytest.mark.parametrize("theta, exc", [(0.0, ValueError), (-1.0, ValueError), (math.nan, ValueError),
+                                        (math.inf, ValueError), (True, TypeError), ("1", TypeError),
+                                        (None, TypeError), (np.array([1.0]), TypeError)])
+def test_bistable_window_rejects_bad_rates(theta, exc):
+    with pytest.raises(exc, match="Theta"):
         bistable_window(BODY, theta)
 
 
@@ -99,7 +100,8 @@ def test_bistable_window_rejects_a_body_that_is_not_one():
         bistable_window({"m": 2.0}, 1.0)
 
 
-@pytest.mark.parametrize("k", [0.0, 1.0, -0.5, math.nan, True])
-def test_threshold_rejects_k_outside_the_open_unit_interval(k):
-    with pytest.raises(ValueError, match="k"):
+@pytest.mark.parametrize("k, exc", [(0.0, ValueError), (1.0, ValueError), (-0.5, ValueError),
+                                    (math.nan, ValueError), (True, TypeError)])
+def test_threshold_rejects_k_outside_the_open_unit_interval(k, exc):
+    with pytest.raises(exc, match="k"):
         torque_pendulum_threshold(k)

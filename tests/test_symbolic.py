@@ -210,7 +210,7 @@ def test_symbolic_brackets_match_finite_differences(expr, h, printed):
         sym = np.broadcast_to(sym, (6,)) if sym.size == 1 else sym
         num = ctrl.numeric_bracket(expr, ctrl.numeric_fields(body, printed=printed), q, h=h)
         scale = 1.0 + np.max(np.abs(sym))
-        np.testing.assert_allclose(num, sym, rtol=0, atol=1e-5 * scale)
+        np.testing.assert_allclose(num, sym, rtol=0, atol=5e-6 * scale)  # measured 4.3e-7 scale: the O(h^2) difference error, h per bracket
 
 
 def test_numeric_bracket_refuses_bad_input():
