@@ -25,12 +25,13 @@ from .dynamics.orbits import MapWithJacobian, Orbit, newton_orbit
 from .integrators import batch
 from .params import Body
 from .rotation_field import coefficients, rotation_rates, rotation_rates_dphi
+from .slow_eight import SlowEight, slow_eight_prediction  # re-exported: Chapter 5's slow eights
 from .trajectories import KINEMATICS, POSITIONS
 
 __all__ = [
     "steps_per_period", "reduced_rotation", "classify_samples", "sampled_range", "sampled_extremes", "rotation_sweep",
     "ENGINES", "rotation_period_map", "rotation_orbit", "RotationLyapunov",
-    "rotation_lyapunov", "WINDING",
+    "rotation_lyapunov", "WINDING", "SlowEight", "slow_eight_prediction",
 ]
 
 
