@@ -15,6 +15,7 @@ import numpy as np
 import pandas as pd
 from scipy.integrate import solve_ivp
 
+from . import checks
 from .angles import wrap_angle
 from .params import Body
 
@@ -25,17 +26,11 @@ __all__ = ["circle_critical_radius", "circle_equilibria", "circle_jacobian", "ci
 
 
 def _check_circle_args(body: Body, R=None, theta=None) -> None:
-    if not isinstance(body, Body):
-        raise TypeError(f"body must be a lib.params.Body, got {type(body).__name__}")
-    for name, v in (("R", R), ("theta", theta)):
-        if v is None:
-            continue
-        if isinstance(v, bool) or not np.isscalar(v) or not np.isfinite(v):
-            raise ValueError(f"{name} must be a finite real number, got {v!r}")
-    if R is not None and R <= 0:
-        raise ValueError(f"circle radius R must be positive, got {R!r} m")
-    if theta is not None and theta <= 0:
-        raise ValueError(f"angular rate theta must be positive (rad/s), got {theta!r}")
+    checks.instance("body", body, Body)
+    if R is not None:
+        checks.number("circle radius R", R, positive=True, unit="m")
+    if theta is not None:
+        checks.number("angular rate theta", theta, positive=True, unit="rad/s")
 
 
 def circle_critical_radius(body: Body, theta: float) -> float:
@@ -91,16 +86,13 @@ def circle_rotation_rhs(body: Body, R, theta, p, v_p) -> np.ndarray:
 
 
 def _circle_arrays(body, R, theta, *arrays):
-    if not isinstance(body, Body):
-        raise TypeError(f"body must be a lib.params.Body, got {type(body).__name__}")
-    out = np.broadcast_arrays(*(np.atleast_1d(np.asarray(a, dtype=float)) for a in (R, theta) + arrays))
+    checks.instance("body", body, Body)
+    names = ("R", "theta", "p0", "v0")[:2 + len(arrays)]
+    checked = [checks.array(n, a, positive=i < 2) for i, (n, a) in enumerate(zip(names, (R, theta) + arrays))]
+    out = np.broadcast_arrays(*(np.atleast_1d(a) for a in checked))
     out = [np.ravel(a).copy() for a in out]
     if out[0].size == 0:
         raise ValueError("empty input arrays")
-    if not all(np.all(np.isfinite(a)) for a in out):
-        raise ValueError("inputs must be finite")
-    if np.any(out[0] <= 0) or np.any(out[1] <= 0):
-        raise ValueError("R (m) and theta (rad/s) must be positive")
     return out
 
 
@@ -289,10 +281,7 @@ def bistable_window(body: Body, Theta: float) -> tuple[float, float]:
     from scipy.optimize import brentq
 
     _check_circle_args(body)
-    if isinstance(Theta, bool) or not isinstance(Theta, (int, float, np.integer, np.floating)) \
-            or not np.isfinite(Theta) or Theta <= 0:
-        raise ValueError(f"Theta must be a positive finite rate (rad/s), got {Theta!r}")
-    Theta = float(Theta)
+    Theta = checks.number("Theta", Theta, positive=True, unit="rad/s")
     r_crit = circle_critical_radius(body, Theta)
 
     def miss(s):                                # s = 1 - k = 1 - R_crit/R
@@ -347,7 +336,8 @@ def torque_pendulum_threshold(k: float = 1.0 - WINDOW_RESOLUTION) -> float:
     """
     from scipy.optimize import brentq
 
-    if isinstance(k, bool) or not np.isscalar(k) or not np.isfinite(k) or not 0.0 < k < 1.0:
+    k = checks.number("k", k, positive=True)
+    if not k < 1.0:
         raise ValueError(f"k must be a number in (0, 1), got {k!r}")
     q_u = math.pi + math.asin(k)
     q_s = -math.asin(k)

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from . import checks
 from .dynamics.orbits import MapWithJacobian, Orbit, newton_orbit
 from .integrators import batch
 from .params import Body
@@ -59,21 +60,17 @@ def _unit_forcing(kind: str, s):
 
 
 def _check_grid(R, Theta):
-    R = np.atleast_1d(np.asarray(R, dtype=float))
-    Theta = np.atleast_1d(np.asarray(Theta, dtype=float))
+    """The points (R_i (m), Theta_i (rad/s)) of a sweep as two equal 1-D float arrays,
+    by :mod:`lib.checks` (a NaN or a non-positive entry is named by its index)."""
+    R = np.atleast_1d(checks.array("R", R))
+    Theta = np.atleast_1d(checks.array("Theta", Theta))
     if R.ndim != 1 or Theta.ndim != 1:
         raise ValueError(f"R and Theta must be 1-D arrays (one grid point per pair), got shapes {R.shape}, {Theta.shape}")
     if R.size == 0:
         raise ValueError("R and Theta must not be empty")
     if R.shape != Theta.shape:
         raise ValueError(f"R and Theta must have equal length, got {R.size} and {Theta.size}")
-    if not (np.all(np.isfinite(R)) and np.all(np.isfinite(Theta))):
-        raise ValueError("R and Theta must be finite")
-    if np.any(R <= 0):
-        raise ValueError(f"R must be positive (m), got min {R.min()!r}")
-    if np.any(Theta <= 0):
-        raise ValueError(f"Theta must be positive (rad/s), got min {Theta.min()!r}")
-    return R, Theta
+    return checks.array("R", R, positive=True), checks.array("Theta", Theta, positive=True)
 
 
 def steps_per_period(body: Body, kind: str, R, Theta, h_lambda: float = 0.125) -> np.ndarray:
@@ -285,26 +282,17 @@ def rotation_sweep(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, tol: floa
     (rad), regime, period (reference periods), slip (turns per period), defect
     (rad, the convergence measure), periods (integrated), steps (per period).
     """
-    if kind not in ("eight", "circle"):
-        raise ValueError(f"kind must be 'eight' or 'circle', got {kind!r}")
-    if not isinstance(body, Body):
-        raise TypeError(f"body must be a lib.params.Body, got {type(body).__name__}")
+    checks.one_of("kind", kind, ("eight", "circle"))
+    checks.instance("body", body, Body)
     R, Theta = _check_grid(R, Theta)
     N = R.size
-    p0 = np.broadcast_to(np.asarray(p0, dtype=float), (N,)).copy()
-    v0 = np.broadcast_to(np.asarray(v0, dtype=float), (N,)).copy()
-    if not (np.all(np.isfinite(p0)) and np.all(np.isfinite(v0))):
-        raise ValueError("initial p0 and v0 must be finite")
-    for name, v, lo in (("min_periods", min_periods, 1), ("max_lag", max_lag, 1)):
-        if not isinstance(v, (int, np.integer)) or v < lo:
-            raise ValueError(f"{name} must be an integer >= {lo}, got {v!r}")
-    if not isinstance(max_periods, (int, np.integer)) or max_periods < max(min_periods, max_lag + 1):
-        raise ValueError(f"max_periods must be an integer >= min_periods and > max_lag, got {max_periods!r}")
-    if engine not in ENGINES:
-        raise ValueError(f"engine must be one of {sorted(ENGINES)}, got {engine!r}")
-    step_period = ENGINES[engine]
-    if not (np.isfinite(tol) and tol > 0):
-        raise ValueError(f"tol must be positive, got {tol!r}")
+    p0 = np.broadcast_to(checks.array("p0", p0), (N,)).copy()
+    v0 = np.broadcast_to(checks.array("v0", v0), (N,)).copy()
+    min_periods = checks.integer("min_periods", min_periods, minimum=1)
+    max_lag = checks.integer("max_lag", max_lag, minimum=1)
+    max_periods = checks.integer("max_periods", max_periods, minimum=max(min_periods, max_lag + 1))
+    step_period = ENGINES[checks.one_of("engine", engine, sorted(ENGINES))]
+    tol = checks.number("tol", tol, positive=True)
     n_pts = (np.full(N, int(steps)) if steps is not None
              else steps_per_period(body, kind, R, Theta, h_lambda))
     cols = {k: np.empty(N, dtype=object if k == "regime" else float)
@@ -350,14 +338,11 @@ def rotation_period_map(body: Body, kind: str, R, Theta, *, steps: int | None = 
     attribute ``winding`` is the number of turns the reference heading makes per
     period (0 on the eight, 1 on the circle).
     """
-    if kind not in ("eight", "circle"):
-        raise ValueError(f"kind must be 'eight' or 'circle', got {kind!r}")
-    if not isinstance(body, Body):
-        raise TypeError(f"body must be a lib.params.Body, got {type(body).__name__}")
+    checks.one_of("kind", kind, ("eight", "circle"))
+    checks.instance("body", body, Body)
     R, Theta = _check_grid(R, Theta)
-    n = int(steps) if steps is not None else int(steps_per_period(body, kind, R, Theta, h_lambda).max())
-    if n < 1:
-        raise ValueError(f"steps must be a positive integer, got {steps!r}")
+    n = (checks.integer("steps", steps, minimum=1) if steps is not None
+         else int(steps_per_period(body, kind, R, Theta, h_lambda).max()))
     A, B, C = coefficients(body, R, Theta)
     h = 2 * np.pi / n
 
@@ -424,10 +409,8 @@ def rotation_lyapunov(body: Body, kind: str, R, Theta, *, periods: int = 200, tr
     rates of successive periods are treated as independent, which is what makes the
     error small only for long runs).
     """
-    if not isinstance(periods, (int, np.integer)) or periods < 2:
-        raise ValueError(f"periods must be an integer >= 2, got {periods!r}")
-    if not isinstance(transient, (int, np.integer)) or transient < 0:
-        raise ValueError(f"transient must be a non-negative integer, got {transient!r}")
+    periods = checks.integer("periods", periods, minimum=2)
+    transient = checks.integer("transient", transient, minimum=0)
     R, Theta = _check_grid(R, Theta)
     step = rotation_period_map(body, kind, R, Theta, steps=steps)
     phi, w = _initial(kind, Theta, np.broadcast_to(np.asarray(p0, float), R.shape),

@@ -19,6 +19,7 @@ from types import MappingProxyType
 import numpy as np
 import pandas as pd
 
+from . import checks
 from .angles import wrap_angle
 from .dynamics import verdicts as dv
 from .dynamics.orbits import floquet_multipliers
@@ -60,26 +61,16 @@ def fig5_map(body: Body, n: int = FIG5_GRID["n"], *, executor=None, chunk_size: 
 
 
 def _check_body_kind(body, kind):
-    if kind not in ("eight", "circle"):
-        raise ValueError(f"kind must be 'eight' or 'circle', got {kind!r}")
-    if not isinstance(body, Body):
-        raise TypeError(f"body must be a lib.params.Body, got {type(body).__name__}")
+    checks.one_of("kind", kind, ("eight", "circle"))
+    checks.instance("body", body, Body)
 
 
 def _check_int(name, v, lo):
-    if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
-        raise TypeError(f"{name} must be an integer, got {type(v).__name__}")
-    if v < lo:
-        raise ValueError(f"{name} must be >= {lo}, got {v!r}")
-    return int(v)
+    return checks.integer(name, v, minimum=lo)
 
 
 def _check_pos(name, v):
-    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
-        raise TypeError(f"{name} must be a number, got {type(v).__name__}")
-    if not (np.isfinite(v) and v > 0):
-        raise ValueError(f"{name} must be positive and finite, got {v!r}")
-    return float(v)
+    return checks.number(name, v, positive=True)
 
 
 _DEFAULTS = dict(transient=48, min_transient=8, chunk=8, max_period=8, lyapunov_periods=300, block=12,
@@ -189,19 +180,17 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
     reason (why undecided).
     """
     _check_body_kind(body, kind)
-    if engine not in ENGINES:
-        raise ValueError(f"engine must be one of {sorted(ENGINES)}, got {engine!r}")
+    checks.one_of("engine", engine, sorted(ENGINES))
     R, Theta = _check_grid(R, Theta)
     h_lambda = _check_pos("h_lambda", h_lambda)
     opts = _verdict_options(options)
     N = R.size
+    p0, v0 = checks.array("p0", p0), checks.array("v0", v0)
     try:
-        p0 = np.broadcast_to(np.asarray(p0, dtype=float), (N,)).copy()
-        v0 = np.broadcast_to(np.asarray(v0, dtype=float), (N,)).copy()
+        p0 = np.broadcast_to(p0, (N,)).copy()
+        v0 = np.broadcast_to(v0, (N,)).copy()
     except ValueError as e:
         raise ValueError(f"p0 and v0 must be scalars or arrays of length {N}") from e
-    if not (np.all(np.isfinite(p0)) and np.all(np.isfinite(v0))):
-        raise ValueError("initial p0 and v0 must be finite")
     n_pts, n_fine = _step_counts(body, kind, R, Theta, h_lambda, steps, opts)
     parts = map_chunks(_verdict_frame, N, (R, Theta, p0, v0, n_pts, n_fine),
                        dict(body=body, kind=kind, opts=opts, engine=engine), executor, chunk_size)

@@ -169,7 +169,7 @@ def test_engines_agree_on_the_verdicts():
 
 
 @pytest.mark.parametrize("kwargs, exc, match", [
-    (dict(R=[-1.0], Theta=[0.5]), ValueError, "R must be positive"),
+    (dict(R=[-1.0], Theta=[0.5]), ValueError, r"R\[0\] must be positive"),
     (dict(R=[np.nan], Theta=[0.5]), ValueError, "finite"),
     (dict(R=[1.0], Theta=[0.5], max_period=0), ValueError, "max_period"),
     (dict(R=[1.0], Theta=[0.5], block=1), ValueError, "block"),
