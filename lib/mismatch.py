@@ -35,7 +35,7 @@ from .parallel import concat_frames, map_chunks
 from .params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from .trajectories import KINEMATICS
 
-__all__ = ["PARAMETERS", "model_of", "linear_position_error", "mismatch_sweep", "influence"]
+__all__ = ["PARAMETERS", "model_of", "error_equation", "linear_position_error", "mismatch_sweep", "influence"]
 
 #: the model's parameters, as :class:`lib.params.Body` names them (m, I_C, c, c_phi, a)
 PARAMETERS = ("m", "I", "c", "c_phi", "a")
@@ -132,6 +132,35 @@ def linear_position_error(body: Body, gains: Gains, model: Body, kind: str, R: f
     return np.fft.ifft(np.fft.fft(force, axis=0) / h, axis=0).real
 
 
+def error_equation():
+    """The x row of the error equation with a mismatch, derived with sympy.
+
+    From the plant's x row of (22), m x'' + c x' = Q_x, with Q_x = tau_x by (25)-(26) and
+    tau_x the x row of (23) computed with the model's m^, c^, the substitution
+    x = x_d - e leaves a linear equation in e. (The y row is the same with y.)
+
+    Returns
+    -------
+    tuple
+        (lhs, rhs, symbols): sympy expressions with lhs = rhs the error equation,
+        lhs = m e'' + (k_v + c - c^) e' + k_p e and rhs the forcing by x_d; ``symbols``
+        maps names (t, m, m_hat, c, c_hat, k_p, k_v, e, x_d) to the sympy objects.
+    """
+    import sympy as sp                      # only here: keeps ``import lib.tracking`` light
+
+    t = sp.symbols("t", real=True)
+    m, m_hat, c, c_hat, kp, kv = sp.symbols(r"m \hat{m} c \hat{c} k_p k_v", positive=True)
+    e, x_d = sp.Function("e")(t), sp.Function("x_d")(t)
+    x = x_d - e
+    tau = m_hat * x_d.diff(t, 2) + c_hat * x.diff(t) + kv * (x_d - x).diff(t) + kp * (x_d - x)   # (23)
+    residual = sp.expand(tau - (m * x.diff(t, 2) + c * x.diff(t)))       # (22) with Q_x = tau_x: = 0
+    lhs = sp.collect(sp.expand(sum(residual.coeff(d) * d for d in (e.diff(t, 2), e.diff(t), e))),
+                     [e.diff(t, 2), e.diff(t), e])
+    rhs = sp.collect(sp.expand(lhs - residual), [x_d.diff(t, 2), x_d.diff(t)])
+    names = dict(t=t, m=m, m_hat=m_hat, c=c, c_hat=c_hat, k_p=kp, k_v=kv, e=e, x_d=x_d)
+    return lhs, rhs, names
+
+
 class _MismatchFlow(_PeriodFlow):
     """The full closed loop's period map (:class:`lib.loop_verdicts._PeriodFlow`, whose
     tables, sections and error map it keeps) with (23) computed from a model of its own
@@ -204,8 +233,9 @@ def mismatch_sweep(body: Body, gains: Gains, kind, R, Theta, mismatch: Mapping, 
         One row per point: kind, R, Theta, d_m, d_I, d_c, d_c_phi, d_a (the deltas), the
         verdict columns of :func:`lib.loop_verdicts.closed_loop_verdicts` (regime, lost,
         turns_round, position_lost, tracked, pos_max and pos_rms (m, last block), pos_drift
-        (m per period), p_range (rad), ...), ``held`` (:func:`lib.dynamics.verdicts.held`)
-        and ``pos_linear`` (m), the largest |(e_x, e_y)| of :func:`linear_position_error`.
+        (m per period), p_range and p_rms (rad, range and RMS of the heading error p), ...), ``held`` (:func:`lib.dynamics.verdicts.held`)
+        and ``pos_linear`` (m), the largest |(e_x, e_y)| of :func:`linear_position_error` at
+        the same samples as pos_max (the ``steps`` step ends of a period).
     """
     checks.instance("body", body, Body)
     checks.instance("gains", gains, Gains)
@@ -237,12 +267,13 @@ def _sweep_chunk(kinds, R, Theta, scale, *, body, gains, z0, dz0, o) -> pd.DataF
     obs = _observe(flow, _start(flow, z0, dz0), o)
     out = _decide(flow, obs, np.ones(R.size, bool), o)
     acc, cnt = obs["acc"], obs["acc"]["cnt"][-1]
-    linear = [np.hypot(*linear_position_error(body, gains, _scaled(body, s), k, r, th).T).max()
+    # the linear solution at the flow's own samples (the step ends, t = j T / steps)
+    linear = [np.hypot(*linear_position_error(body, gains, _scaled(body, s), k, r, th, o["steps"]).T).max()
               for k, r, th, s in zip(kinds, R, Theta, scale)]
     return pd.DataFrame({"kind": kinds, "R": R, "Theta": Theta,
                          **{f"d_{p}": scale[:, j] - 1.0 for j, p in enumerate(PARAMETERS)}, **out,
                          "held": dv.held(out["regime"], out["lost"], out["tracked"]),
-                         "p_range": acc["lmax"] - acc["lmin"], "pos_rms": np.sqrt(acc["pos2"] / cnt),
+                         "p_range": acc["lmax"] - acc["lmin"], "p_rms": np.sqrt(acc["p2"] / cnt), "pos_rms": np.sqrt(acc["pos2"] / cnt),
                          "pos_max": acc["posmax"], "pos_linear": linear, "periods": int(obs["t_end"]),
                          "steps": o["steps"]})
 
@@ -281,8 +312,8 @@ def influence(frame: pd.DataFrame) -> pd.DataFrame:
             ref = ref.iloc[0]
             one = frame[(frame.kind == kind).to_numpy() & (d[:, j] != 0)
                         & np.all(np.delete(d, j, axis=1) == 0, axis=1)]
-            pos = max(pos, float(np.abs(one.pos_max - ref.pos_max).max(initial=0.0)))
-            dp = max(dp, float(np.abs(one.p_range - ref.p_range).max(initial=0.0)))
+            pos = max(pos, float(np.abs(one.pos_max.to_numpy() - ref.pos_max).max(initial=0.0)))
+            dp = max(dp, float(np.abs(one.p_range.to_numpy() - ref.p_range).max(initial=0.0)))
             changed += int(((one.regime != ref.regime) | (one.lost != ref.lost)).sum())
         rows.append({"parameter": p, "pos_change": pos, "p_range_change": dp, "verdicts": changed})
     return pd.DataFrame(rows).sort_values(["pos_change", "p_range_change"], ascending=False,
