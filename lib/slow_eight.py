@@ -212,7 +212,6 @@ def _periodic_range(A, B, C, f, H, n: int, corrected: bool, n_starts: int = 16, 
     rows = np.arange(N)
     lo, hi = x[i], x[i] + 2 * np.pi / n_starts
     glo, ghi = g[rows, i], np.roll(g, -1, axis=1)[rows, i]
-    lo, hi, glo, ghi = (np.where(slips, v, v) for v in (lo, hi, glo, ghi))
     ok = ~slips
     glo, ghi = np.where(ok, glo, 1.0), np.where(ok, ghi, -1.0)
     side = np.zeros(N, dtype=int)
