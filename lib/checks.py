@@ -175,6 +175,7 @@ def array(name: str, value: Any, *, shape: tuple | None = None, finite: bool = T
             ok = all(w is None or w == g for w, g in zip(tail, got_tail))
         if not ok:
             txt = ", ".join("..." if w is Ellipsis else ("n" if w is None else str(w)) for w in want)
+            txt += "," if len(want) == 1 else ""
             raise ValueError(f"{name} must have shape ({txt}), got shape {arr.shape}")
     if nonempty and arr.size == 0:
         raise ValueError(f"{name} must not be empty")

@@ -15,6 +15,7 @@ from typing import Callable
 
 import numpy as np
 
+from . import checks
 from .allocation import Allocation, Allocator, Limits
 from .control import computed_torque_from
 from .model import config_accel
@@ -49,13 +50,10 @@ class ClosedLoop:
     @classmethod
     def of(cls, body: Body, gains: Gains, kinematics: Kinematics, allocation: Allocation | None = None,
            limits: Limits | None = None, model: Body | None = None) -> "ClosedLoop":
-        if not isinstance(gains, Gains):
-            raise TypeError(f"gains must be a lib.params.Gains, got {type(gains).__name__}")
-        allocation = Allocation() if allocation is None else allocation
-        if not isinstance(allocation, Allocation):
-            raise TypeError(f"allocation must be a lib.allocation.Allocation, got {type(allocation).__name__}")
-        if model is not None and not isinstance(model, Body):
-            raise TypeError(f"model must be a lib.params.Body or None, got {type(model).__name__}")
+        checks.instance("gains", gains, Gains)
+        allocation = checks.instance("allocation", Allocation() if allocation is None else allocation, Allocation)
+        if model is not None:
+            checks.instance("model", model, Body, "lib.params.Body or None")
         return cls(body, gains, kinematics, allocation.bind(body if model is None else model, limits), model)
 
     def inputs(self, t, z, dz):

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from . import checks
 from .allocation import Allocation, Limits
 from .closed_loop import ClosedLoop, reference_of
 from .integrators.smooth import Integration, SimulationError, integrate
@@ -86,20 +87,11 @@ class SimulationResult:
 
 
 def _vector(name: str, value, default) -> np.ndarray:
-    arr = np.asarray(default if value is None else value, dtype=float)
-    if arr.shape != (3,):
-        raise ValueError(f"{name} must have shape (3,), got {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must be finite, got {arr}")
-    return arr
+    return checks.array(name, default if value is None else value, shape=(3,))
 
 
 def _instance(name: str, value, cls):
-    if value is None:
-        return cls()
-    if not isinstance(value, cls):
-        raise TypeError(f"{name} must be a {cls.__module__}.{cls.__name__}, got {type(value).__name__}")
-    return value
+    return cls() if value is None else checks.instance(name, value, cls)
 
 
 def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz0=None, *,
@@ -123,24 +115,21 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
     limit below pi and the position-only law; in the result, ``beta`` while
     sliding is the Filippov average angle and ``mode`` records the side.
     """
-    if not isinstance(body, Body):
-        raise TypeError(f"body must be a lib.params.Body, got {type(body).__name__}")
-    if not isinstance(gains, Gains):
-        raise TypeError(f"gains must be a lib.params.Gains, got {type(gains).__name__}")
+    checks.instance("body", body, Body)
+    checks.instance("gains", gains, Gains)
     if not all(callable(getattr(ref, k, None)) for k in ("z", "dz", "ddz")):
         raise TypeError(f"ref must be a reference with z, dz and ddz methods, got {type(ref).__name__}")
-    if isinstance(t_end, bool) or not np.isscalar(t_end) or not np.isfinite(t_end) or t_end <= 0:
-        raise ValueError(f"t_end must be a positive finite time in s, got {t_end!r}")
+    t_end = checks.number("t_end", t_end, positive=True, unit="s")
     z0 = _vector("z0", z0, PAPER_Z0)
     dz0 = _vector("dz0", dz0, PAPER_DZ0)
     limits = _instance("limits", limits, Limits)
     allocation = _instance("allocation", allocation, Allocation)
     integration = _instance("integration", integration, Integration)
-    if model is not None and not isinstance(model, Body):
-        raise TypeError(f"model must be a lib.params.Body or None, got {type(model).__name__}")
+    if model is not None:
+        checks.instance("model", model, Body, "lib.params.Body or None")
     if t_eval is None:
         t_eval = np.linspace(0.0, t_end, int(round(t_end * DEFAULT_RATE)) + 1)
-    t_eval = np.asarray(t_eval, dtype=float)
+    t_eval = checks.array("t_eval", t_eval)
     if t_eval.ndim != 1 or t_eval.size == 0 or t_eval[0] < 0 or t_eval[-1] > t_end or np.any(np.diff(t_eval) <= 0):
         raise ValueError("t_eval must be a non-empty increasing 1-D array within [0, t_end]")
     if integration.switching == "events":
@@ -197,9 +186,11 @@ def simulate_open_loop(body: Body, F, beta, q0, t_end: float, *, form: str = "co
         raise ValueError(f"unknown model form {form!r}; known: {OPEN_LOOP_FORMS}")
     if not (callable(F) and callable(beta)):
         raise TypeError("F and beta must be callables of time t (s)")
-    q0 = np.asarray(q0, dtype=float)
-    if q0.shape != (6,) or not np.all(np.isfinite(q0)):
+    checks.instance("body", body, Body)
+    q0 = checks.array("q0", q0)
+    if q0.shape != (6,):
         raise ValueError(f"q0 must be a finite array of shape (6,), got {q0!r}")
+    t_end = checks.number("t_end", t_end, positive=True, unit="s")
     if t_eval is None:
         t_eval = np.linspace(0.0, t_end, int(round(t_end * DEFAULT_RATE)) + 1)
 
