@@ -70,8 +70,8 @@ def test_heading_rate_and_acceleration_are_derivatives_of_the_heading(kind, R, t
     zm, dzm, _ = kin(R, theta, t - H)
     rate_err = np.abs((zp[:, 2] - zm[:, 2]) / (2 * H) - dz[:, 2]).max()
     acc_err = np.abs((dzp[:, 2] - dzm[:, 2]) / (2 * H) - ddz[:, 2]).max()
-    assert rate_err < 2e-8 * abs(theta), rate_err
-    assert acc_err < 1.5e-7 * theta**2, acc_err
+    assert rate_err < 2e-8 * abs(theta), rate_err  # measured 2.0e-9 |Theta|
+    assert acc_err < 1.5e-7 * theta**2, acc_err  # measured 1.35e-8 Theta^2
     # and the reference objects serve the same arrays
     ref = T.make(kind, R, theta)
     np.testing.assert_array_equal(ref.dz(t)[:, 2], dz[:, 2])
