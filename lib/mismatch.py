@@ -35,7 +35,8 @@ from .parallel import concat_frames, map_chunks
 from .params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from .trajectories import KINEMATICS
 
-__all__ = ["PARAMETERS", "model_of", "error_equation", "linear_position_error", "mismatch_sweep", "influence"]
+__all__ = ["PARAMETERS", "model_of", "error_equation", "linear_position_error", "mismatch_sweep", "influence",
+           "mismatch_study"]
 
 #: the model's parameters, as :class:`lib.params.Body` names them (m, I_C, c, c_phi, a)
 PARAMETERS = ("m", "I", "c", "c_phi", "a")
@@ -318,3 +319,53 @@ def influence(frame: pd.DataFrame) -> pd.DataFrame:
         rows.append({"parameter": p, "pos_change": pos, "p_range_change": dp, "verdicts": changed})
     return pd.DataFrame(rows).sort_values(["pos_change", "p_range_change"], ascending=False,
                                           kind="stable").reset_index(drop=True)
+
+
+def mismatch_study(body: Body, gains: Gains, R: float, Theta: float, *, levels=(-0.2, -0.1, 0.1, 0.2),
+                   map_levels=tuple(np.linspace(-0.2, 0.2, 13)), kinds=("circle", "eight"), executor=None,
+                   chunk_size: int | None = None, **options) -> dict:
+    """Chapter 3's study of a wrong model: each parameter off alone, the ranking, and a map
+    over the two that matter most.
+
+    Parameters
+    ----------
+    body, gains : Body, Gains
+        The plant and the gains of (23).
+    R, Theta : float
+        Size (m) and rate (rad/s) of both references.
+    levels : sequence of float
+        The relative errors of the one-at-a-time runs (the exact model is added).
+    map_levels : sequence of float
+        The relative errors of each axis of the map.
+    kinds : sequence of str
+        The references ("circle", "eight").
+    executor, chunk_size, **options
+        As for :func:`mismatch_sweep`.
+
+    Returns
+    -------
+    dict
+        ``single`` (the one-at-a-time frame, the exact model first for each kind),
+        ``influence`` (:func:`influence` of it), ``pair`` (the two most influential
+        parameters) and ``map`` (the frame over ``pair``: for each kind, the first
+        parameter's level slowest).
+    """
+    levels = checks.array("levels", levels, ndim=1, nonempty=True)
+    map_levels = checks.array("map_levels", map_levels, ndim=1, nonempty=True)
+    cols = {p: [] for p in PARAMETERS}
+    kind_col = []
+    for kind in kinds:
+        for p in (None,) + PARAMETERS:
+            for v in ([0.0] if p is None else levels):
+                kind_col.append(kind)
+                for q in PARAMETERS:
+                    cols[q].append(v if q == p else 0.0)
+    run = dict(executor=executor, chunk_size=chunk_size, **options)
+    single = mismatch_sweep(body, gains, np.array(kind_col, dtype=object), R, Theta, cols, **run)
+    rank = influence(single)
+    pair = tuple(rank.parameter[:2])
+    a, b = np.meshgrid(map_levels, map_levels, indexing="ij")
+    n = a.size
+    grid = mismatch_sweep(body, gains, np.repeat(np.array(kinds, dtype=object), n), R, Theta,
+                          {pair[0]: np.tile(a.ravel(), len(kinds)), pair[1]: np.tile(b.ravel(), len(kinds))}, **run)
+    return {"single": single, "influence": rank, "pair": pair, "map": grid}
