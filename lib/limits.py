@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from . import checks
 from .angles import state_difference
 from .dynamics import verdicts as dv
 from .dynamics.lyapunov import LyapunovEstimate, largest_lyapunov
@@ -27,9 +28,9 @@ from .integrators.switched import Segments, SwitchedLoop
 from .parallel import map_chunks, map_in_processes
 from .params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from .rotation import sampled_extremes, sampled_range
-from .switched_runs import (STEPS_PER_PERIOD, SwitchedRuns, _concat_runs, _limits_arrays, _start_states,
-                            error_state, switched_runs)
-from .trajectories import Circle, Eight, Reference
+from .switched_runs import (STEPS_PER_PERIOD, SwitchedRuns, _check_parts, _concat_runs, _limits_arrays,
+                            _start_states, error_state, switched_runs)
+from .trajectories import Reference
 
 __all__ = [
     "error_state", "stroboscopic_section", "Regime", "classify", "section_sweep", "sweep_angle_limit",
@@ -94,6 +95,26 @@ def _section_one(args):
     return stroboscopic_section(loop, s0, n_transient, n_points, rtol=rtol, atol=atol)
 
 
+def _start(z0, dz0) -> np.ndarray:
+    """The start state (z0, dz0) of a sweep, the paper's Table by default, checked."""
+    return np.concatenate([checks.array("z0", PAPER_Z0 if z0 is None else z0, shape=(3,)),
+                           checks.array("dz0", PAPER_DZ0 if dz0 is None else dz0, shape=(3,))])
+
+
+def _check_sweep(body, gains, ref, angle_limits, force_limit, **numbers) -> np.ndarray:
+    """Check a sweep's parts, limits and options (``n_*`` integers, the rest positive
+    numbers) by :mod:`lib.checks`; returns the angle limits (rad) as a 1-D array."""
+    _check_parts(body, gains, ref)
+    if force_limit is not None:
+        checks.number("force_limit", force_limit, positive=True)
+    for name, v in numbers.items():
+        if name.startswith("n_"):
+            checks.integer(name, v, minimum=0 if name == "n_transient" else 1)
+        else:
+            checks.number(name, v, positive=True)
+    return _limits_arrays(angle_limits, None)[0]
+
+
 def section_sweep(body: Body, gains: Gains, ref: Reference, angle_limits, *, force_limit=None,
                   n_transient: int = 20, n_points: int = 24, rtol: float = 1e-8, atol: float = 1e-8,
                   z0=None, dz0=None, workers: int = 1) -> list[np.ndarray]:
@@ -101,10 +122,10 @@ def section_sweep(body: Body, gains: Gains, ref: Reference, angle_limits, *, for
     ``n_points`` error states after ``n_transient`` periods) for each angle limit (rad),
     from the paper's initial state unless ``z0``/``dz0`` are given; ``workers``
     processes share the sweep."""
-    s0 = np.concatenate([np.asarray(PAPER_Z0 if z0 is None else z0, dtype=float),
-                         np.asarray(PAPER_DZ0 if dz0 is None else dz0, dtype=float)])
-    items = [(body, gains, ref, float(b), force_limit, n_transient, n_points, rtol, atol, s0)
-             for b in np.atleast_1d(np.asarray(angle_limits, dtype=float))]
+    angles = _check_sweep(body, gains, ref, angle_limits, force_limit, n_transient=n_transient,
+                          n_points=n_points, rtol=rtol, atol=atol)
+    s0 = _start(z0, dz0)
+    items = [(body, gains, ref, float(b), force_limit, n_transient, n_points, rtol, atol, s0) for b in angles]
     return map_in_processes(_section_one, items, workers)
 
 
@@ -119,10 +140,11 @@ def sweep_angle_limit(body: Body, gains: Gains, ref: Reference, angle_limits, *,
     and the largest Lyapunov exponent estimated over ``n_lyap`` periods starting
     from the end of the section.
     """
-    s0 = np.concatenate([np.asarray(PAPER_Z0 if z0 is None else z0, dtype=float),
-                         np.asarray(PAPER_DZ0 if dz0 is None else dz0, dtype=float)])
+    angles = _check_sweep(body, gains, ref, angle_limits, force_limit, n_transient=n_transient,
+                          n_points=n_points, n_lyap=n_lyap, tol=tol, rtol=rtol, atol=atol, d0=d0)
+    s0 = _start(z0, dz0)
     items = [(body, gains, ref, float(b), force_limit, n_transient, n_points, n_lyap, tol, rtol, atol, d0, s0)
-             for b in np.atleast_1d(np.asarray(angle_limits, dtype=float))]
+             for b in angles]
     return map_in_processes(_regime_one, items, workers)
 
 
@@ -227,13 +249,14 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
     if unknown:
         raise TypeError(f"unknown options {sorted(unknown)}; known: {sorted(LIMIT_DEFAULTS)}")
     o = {**LIMIT_DEFAULTS, **options}
+    for name, v in o.items():
+        minimum = {"transient": 0, "periods": 2, "block": 2, "max_period": 1}.get(name)
+        o[name] = checks.number(name, v, positive=True) if minimum is None else checks.integer(name, v, minimum=minimum)
     npr, blk, kmax = o["periods"], o["block"], o["max_period"]
     if npr < 2 * blk or npr < 2 * kmax + 2:
         raise ValueError(f"periods ({npr}) must cover two blocks ({blk}) and twice max_period ({kmax})")
-    if not isinstance(body, Body) or not isinstance(gains, Gains):
-        raise TypeError("body and gains must be lib.params.Body and lib.params.Gains")
-    if not isinstance(ref, (Circle, Eight)):
-        raise TypeError(f"ref must be lib.trajectories.Circle or Eight, got {type(ref).__name__}")
+    _check_parts(body, gains, ref)
+    steps_per_period = checks.integer("steps_per_period", steps_per_period, minimum=16)
     b, f = _limits_arrays(angle_limits, force_limits)
     S0 = _start_states(s0, b.size)
     parts = map_chunks(_limit_chunk, b.size, (b, f, S0), dict(body=body, gains=gains, ref=ref, o=o,

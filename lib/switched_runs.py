@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import checks
 from .angles import wrap_angle
 from .integrators.batch import dop853
 from .params import PAPER_DZ0, PAPER_Z0, Body, Gains
@@ -59,8 +60,8 @@ STEPS_PER_PERIOD = 200
 
 
 def _limits_arrays(angle_limits, force_limits):
-    b = np.atleast_1d(np.asarray(angle_limits, dtype=float))
-    f = np.atleast_1d(np.asarray(np.inf if force_limits is None else force_limits, dtype=float))
+    b = np.atleast_1d(checks.array("angle_limits", angle_limits))
+    f = np.atleast_1d(checks.array("force_limits", np.inf if force_limits is None else force_limits, finite=False))
     if b.ndim != 1 or f.ndim != 1 or b.size == 0:
         raise ValueError("angle_limits and force_limits must be scalars or 1-D arrays, not empty")
     try:
@@ -75,9 +76,16 @@ def _limits_arrays(angle_limits, force_limits):
     return b.copy(), f.copy()
 
 
+def _check_parts(body, gains, ref) -> None:
+    """The body, gains and reference of a switched run (TypeError naming a wrong one)."""
+    checks.instance("body", body, Body)
+    checks.instance("gains", gains, Gains)
+    checks.instance("ref", ref, (Circle, Eight), "lib.trajectories.Circle or Eight")
+
+
 def _start_states(s0, n: int) -> np.ndarray:
     """The start of each of ``n`` runs (n, 6): the paper's initial state, or ``s0`` (6,) or (n, 6)."""
-    S0 = np.concatenate([PAPER_Z0, PAPER_DZ0]) if s0 is None else np.asarray(s0, dtype=float)
+    S0 = np.concatenate([PAPER_Z0, PAPER_DZ0]) if s0 is None else checks.array("s0", s0)
     S0 = np.broadcast_to(S0, (n, 6)) if S0.shape == (6,) or S0.shape == (1, 6) else S0
     if S0.shape != (n, 6) or not np.all(np.isfinite(S0)):
         raise ValueError(f"s0 must be a finite state (6,) or one per run ({n}, 6), got shape {S0.shape}")
@@ -112,25 +120,20 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
     events accumulate (more than 200 in one step)."""
     from .integrators.switched_compiled import run_periods  # numba compiles on first use: only when asked
 
-    if not isinstance(body, Body) or not isinstance(gains, Gains):
-        raise TypeError("body and gains must be lib.params.Body and lib.params.Gains")
-    if not isinstance(ref, (Circle, Eight)):
-        raise TypeError(f"ref must be lib.trajectories.Circle or Eight, got {type(ref).__name__}")
+    _check_parts(body, gains, ref)
     b, f = _limits_arrays(angle_limits, force_limits)
-    if isinstance(n_periods, bool) or not isinstance(n_periods, (int, np.integer)) or n_periods < 1:
-        raise ValueError(f"n_periods must be a positive integer, got {n_periods!r}")
-    lf = -1 if lyapunov_from is None else int(lyapunov_from)
+    n_periods = checks.integer("n_periods", n_periods, minimum=1)
+    lf = -1 if lyapunov_from is None else checks.integer("lyapunov_from", lyapunov_from)
     if lyapunov_from is not None and not 0 <= lf < n_periods - 1:
         raise ValueError(f"lyapunov_from must be in [0, n_periods - 1), got {lyapunov_from!r}")
-    if not (isinstance(steps_per_period, (int, np.integer)) and steps_per_period >= 16):
-        raise ValueError(f"steps_per_period must be an integer >= 16, got {steps_per_period!r}")
-    S = samples_per_period
-    if not (isinstance(S, (int, np.integer)) and S >= 1 and steps_per_period % S == 0):
+    steps_per_period = checks.integer("steps_per_period", steps_per_period, minimum=16)
+    S = checks.integer("samples_per_period", samples_per_period, minimum=1)
+    if steps_per_period % S:
         raise ValueError(f"samples_per_period must be a positive integer dividing steps_per_period "
                          f"({steps_per_period}), got {S!r}")
     if S > 1 and lyapunov_from is not None:
         raise ValueError("the Lyapunov companion needs samples_per_period = 1")
-    if not (np.isfinite(d0) and 0 < d0 < 1e-3):
+    if not checks.number("d0", d0, positive=True) < 1e-3:
         raise ValueError(f"d0 must be in (0, 1e-3), got {d0!r}")
     S0 = _start_states(s0, b.size)
     g = gains

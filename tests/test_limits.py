@@ -326,7 +326,7 @@ def test_switched_runs_reject_bad_input():
         L.switched_runs(Body(), Gains(), ref, [0.5, 4.0], n_periods=1)
     with pytest.raises(ValueError, match="force limit"):
         L.switched_runs(Body(), Gains(), ref, 0.5, -1.0, n_periods=1)
-    with pytest.raises(ValueError, match="s0 must be a finite state"):
+    with pytest.raises(ValueError, match=r"s0\[1\] must be finite"):
         L.switched_runs(Body(), Gains(), ref, 0.5, s0=[1.0, np.nan, 0, 0, 0, 0], n_periods=1)
     with pytest.raises(TypeError, match="Circle or Eight"):
         L.switched_runs(Body(), Gains(), object(), 0.5, n_periods=1)
