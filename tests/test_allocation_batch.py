@@ -19,8 +19,8 @@ def test_batch_rk4_agrees_with_adaptive_simulation(kind, w_phi):
     ref = T.make(kind, 2.0, np.pi / 4)
     exact = simulate(body, gains, ref, t_end, t_eval=batch.t, allocation=Allocation("least_squares", (1.0, 1.0, w_phi)),
                      integration=Integration(rtol=1e-11, atol=1e-11))
-    assert np.abs(batch.z[:, 0, :] - exact.z).max() < 1e-5
-    np.testing.assert_allclose(batch.F[:, 0], exact.F, atol=1e-4)
+    assert np.abs(batch.z[:, 0, :] - exact.z).max() < 1e-5  # measured 3.5e-6: RK4 at dt = 20 ms
+    np.testing.assert_allclose(batch.F[:, 0], exact.F, rtol=0, atol=3e-5)  # measured 2.7e-6
 
 
 def test_rk4_error_shrinks_at_fourth_order():
@@ -35,7 +35,7 @@ def test_rk4_error_shrinks_at_fourth_order():
 
 def test_paper_law_from_the_reference_keeps_position_error_at_integration_error():
     res = weighting.closed_loop_batch(Body(), Gains(), "eight", [1.0, 3.0], [0.5, 1.2], (1, 1, 0), t_end=30.0)
-    assert res.position_error.max() < 1e-7
+    assert res.position_error.max() < 3e-8  # measured 3.2e-9
 
 
 def test_steady_metrics_flag_a_body_that_leaves_the_circle():
@@ -43,7 +43,7 @@ def test_steady_metrics_flag_a_body_that_leaves_the_circle():
                                        t_end=100.0, dt=0.02, z0=PAPER_Z0, dz0=PAPER_DZ0)
     m = weighting.steady_metrics(res)
     assert m.position_held.tolist() == [True, False]
-    assert m.pos_rms[0] < 1e-6 and m.pos_rms[1] > 10.0
+    assert m.pos_rms[0] < 1e-7 and m.pos_rms[1] > 10.0  # measured 7.7e-9; reason: > 10 is a property (measured 233)
 
 
 def test_steady_metrics_need_enough_periods():
@@ -107,7 +107,7 @@ def test_stability_boundary_reads_the_first_change_of_verdict():
     f["tracked"] = ~f.position_lost
     b = weighting.stability_boundary([0.0, 0.1, 0.2, 0.4], f)
     assert (b["last_held"], b["first_lost"], b["changes"]) == (0.1, 0.2, 2)
-    assert b["verdict"] == "chaotic, position not tracked" and b["ratio"] == pytest.approx(2.0)
+    assert b["verdict"] == "chaotic, position not tracked" and b["ratio"] == pytest.approx(2.0, abs=1e-15)  # measured 0
     with pytest.raises(ValueError, match="increasing"):
         weighting.stability_boundary([0.1, 0.0, 0.2, 0.3], f)
 
@@ -123,9 +123,9 @@ def test_batch_with_limits_agrees_with_adaptive_simulation(law, angle):
                                      z0=PAPER_Z0, dz0=PAPER_DZ0, allocation=law, limits=lim)
     exact = simulate(body, gains, T.make("eight", 2.0, np.pi / 4), 6.0, t_eval=b.t, allocation=Allocation(law, w),
                      limits=lim, integration=Integration(rtol=1e-9, atol=1e-9))
-    assert np.abs(b.z[:, 0] - exact.z).max() < 5e-5
-    assert np.abs(b.F[:, 0] - exact.F).max() < 5e-4
-    assert b.F.max() <= 4.0 + 1e-12
+    assert np.abs(b.z[:, 0] - exact.z).max() < 5e-5  # measured 7.1e-6
+    assert np.abs(b.F[:, 0] - exact.F).max() < 2e-4  # measured 1.8e-5
+    assert b.F.max() <= 4.0 + 1e-15  # measured 0 over the cap
 
 
 def test_batch_allocation_and_limits_are_validated():
@@ -146,7 +146,7 @@ def test_chapter_6_limits_comparison_is_converged_in_the_step_and_its_directions
                                         dt=dt, z0=PAPER_Z0, dz0=PAPER_DZ0).set_index(["limits", "law"])
             for dt in (0.04, 0.02)]
     for col in ("pos_rms", "p_rms"):
-        assert (runs[0][col] - runs[1][col]).abs().max() < 0.003
+        assert (runs[0][col] - runs[1][col]).abs().max() < 0.003  # measured 2.8e-3; reason: a step-convergence bound, below the exact-minus-projection gaps it reads
     for r in runs:
         for s in sets:
             assert r.loc[(s, "exact"), "p_rms"] < r.loc[(s, "projection"), "p_rms"] - 0.003
