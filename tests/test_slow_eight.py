@@ -169,3 +169,12 @@ def test_n_phase_must_be_an_integer_of_at_least_64():
         slow_eight_prediction(BODY, 1.0, 0.1, n_phase=100.0)
     with pytest.raises(ValueError, match="n_phase"):
         slow_eight_prediction(BODY, 1.0, 0.1, n_phase=8)
+
+
+def test_helpers_check_their_arguments():
+    with pytest.raises(ValueError, match=r"R\[0\]"):
+        frozen_heading(BODY, [-1.0], 0.1, 0.0)
+    with pytest.raises(TypeError, match="body"):
+        follow_radius(None, 0.1)
+    with pytest.raises(ValueError, match="Theta"):
+        follow_radius(BODY, -0.1)
