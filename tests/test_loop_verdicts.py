@@ -39,11 +39,11 @@ def test_paper_law_through_the_loop_verdict_agrees_with_chapter_5(both_laws):
     assert paper.period.tolist()[::2] == ch5.period.tolist()[::2] == [1, 1]
     # the same orbits: their Floquet moduli agree (the full loop adds the position errors'
     # multipliers, exp(-1.6 T) < 2e-3, below the rotation's here)
-    np.testing.assert_allclose(paper.floquet.iloc[[0, 2]], ch5.floquet.iloc[[0, 2]], rtol=0.05, atol=1e-5)
+    np.testing.assert_allclose(paper.floquet.iloc[[0, 2]], ch5.floquet.iloc[[0, 2]], rtol=0.03, atol=0)  # measured 3.0e-3 relative: the full loop's own multipliers
     # the chaotic point: lambda T clear of the band by many standard errors in both
     lam = paper.lyapunov.iloc[1] * 2 * np.pi / TH_GRID[3]
     assert lam > max(5 * paper.lyapunov_stderr.iloc[1] * 2 * np.pi / TH_GRID[3], 0.1)
-    assert abs(paper.slip.iloc[2]) == 1.0 and (paper.pos_rms.iloc[:3] < 1e-4).all()
+    assert abs(paper.slip.iloc[2]) == 1.0 and (paper.pos_rms.iloc[:3] < 7e-5).all()  # measured 6.7e-6
 
 
 def test_both_laws_are_classified_by_the_same_function_from_the_same_start(both_laws):
@@ -75,12 +75,12 @@ def test_a_periodic_verdict_agrees_with_a_long_adaptive_run():
     run = simulate(body, gains, ref, 36 * Tp, z0, dz0, allocation=Allocation("least_squares", w),
                    t_eval=np.arange(0, 36 * Tp + 1e-9, Tp / 128), integration=Integration(rtol=1e-10, atol=1e-10))
     e = np.concatenate([run.z - run.z_d, run.dz - ref.dz(run.t)], axis=1)[::128]
-    assert np.abs(e[-1] - e[-2]).max() < 1e-8                     # the section repeats every period
+    assert np.abs(e[-1] - e[-2]).max() < 3e-11                     # measured 3.3e-12; the section repeats every period
     last = run.t >= run.t[-1] - 12 * Tp
     p = run.z[last, 2] - run.z_d[last, 2]
     pos = np.hypot(*(run.z[last, :2] - run.z_d[last, :2]).T)
     # the verdict's steady measures (RK4, 128 steps per period) against the long run's
-    assert abs(v.p_range - np.ptp(p)) < 1e-3 and abs(v.pos_rms - np.sqrt(np.mean(pos ** 2))) < 1e-4
+    assert abs(v.p_range - np.ptp(p)) < 2.5e-4 and abs(v.pos_rms - np.sqrt(np.mean(pos ** 2))) < 1e-4  # measured 2.4e-5 and 1.5e-5: RK4 at 128 steps a period
 
 
 def test_lean_field_is_the_closed_loop_of_eqs_23_and_2_4():
@@ -96,7 +96,7 @@ def test_lean_field_is_the_closed_loop_of_eqs_23_and_2_4():
             y = np.concatenate(flow.kin(idx)(tau * flow.T)[:2], axis=1) + rng.normal(size=(N, 6))
             lean = flow.field(idx, tau, y)
             full = flow.T[:, None] * loop.rates(tau * flow.T, y)[0]
-            assert np.abs(lean - full).max() <= 1e-12 * np.abs(full).max()
+            assert np.abs(lean - full).max() <= 1e-13 * np.abs(full).max()  # measured 1.1e-14 max |full|
 
 
 @pytest.mark.parametrize("kw,exc,msg", [
