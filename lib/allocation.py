@@ -79,7 +79,7 @@ def allocate(tau, phi, force_limit: float | None = None, angle_limit: float | No
 
     Returns (F, beta) as arrays of the broadcast shape of tau[..., 0] and phi.
     """
-    return _position(_check_tau(tau, (2, 3)), phi, Limits(force_limit, angle_limit))
+    return _position(_check_tau(tau, (2, 3)), checks.array("phi", phi), Limits(force_limit, angle_limit))
 
 
 def _position(tau, phi, limits: Limits):
@@ -99,7 +99,7 @@ def _check_weights(weights) -> np.ndarray:
 
 
 def _check_tau(tau, n=(3,)) -> np.ndarray:
-    tau = np.asarray(tau) if isinstance(tau, np.ndarray) and tau.dtype.kind == "f" else checks.array("tau", tau, finite=False)
+    tau = checks.array("tau", tau)
     if tau.ndim == 0 or tau.shape[-1] not in n:
         names = "3 (tau_x, tau_y, tau_phi)" if n == (3,) else "2 or 3"
         raise ValueError(f"tau must have a last axis of length {names}, got shape {tau.shape}")
@@ -115,7 +115,7 @@ def least_squares_problem(tau, phi, body: Body, weights):
     see :func:`_ls_kernel`."""
     tau = _check_tau(tau)
     w = _check_weights(weights)
-    return _ls_kernel(tau, phi, _checked_body(body), np.sqrt(w))
+    return _ls_kernel(tau, checks.array("phi", phi), _checked_body(body), np.sqrt(w))
 
 
 def _ls_kernel(tau, phi, body: Body, sw):
@@ -137,8 +137,23 @@ def _ls_kernel(tau, phi, body: Body, sw):
     u = np.stack([(G[..., 1, 1] * r[..., 0] - G[..., 0, 1] * r[..., 1]) / safe,
                   (G[..., 0, 0] * r[..., 1] - G[..., 1, 0] * r[..., 0]) / safe], axis=-1)
     if not np.all(regular):
-        u = np.where(regular[..., None], u, (np.linalg.pinv(A) @ b[..., None])[..., 0])
+        u = _pinv_rows(u, regular, A, b)
     return u, G, r, np.einsum("...k,...k->...", b, b)
+
+
+def _pinv_rows(u, regular, A, b):
+    """u with its singular rows (``regular`` False) replaced by the minimum-norm solution
+    A^+ b, computed on those rows only; a row with a non-finite A or b (a state that has
+    blown up) gets NaN there instead of failing the whole batch's SVD."""
+    shape = np.broadcast_shapes(u.shape[:-1], regular.shape, A.shape[:-2], b.shape[:-1])
+    u = np.array(np.broadcast_to(u, shape + (2,)))
+    bad = ~np.broadcast_to(regular, shape)
+    Ab, bb = np.broadcast_to(A, shape + (3, 2))[bad], np.broadcast_to(b, shape + (3,))[bad]
+    ok = np.all(np.isfinite(Ab), axis=(-2, -1)) & np.all(np.isfinite(bb), axis=-1)
+    sol = np.full(bb.shape[:-1] + (2,), np.nan)
+    sol[ok] = (np.linalg.pinv(Ab[ok]) @ bb[ok][..., None])[..., 0]
+    u[bad] = sol
+    return u
 
 
 def residual(u, G, r, bb) -> np.ndarray:
@@ -167,7 +182,7 @@ def allocate_limited(tau, phi, body: Body, weights=(1.0, 1.0, 0.0),
     exactly (25)-(26). Returns (F (N), beta (rad)) like :func:`allocate`.
     """
     limits = Limits(force_limit, angle_limit)
-    return _limited(_check_tau(tau), phi, _checked_body(body), np.sqrt(_check_weights(weights)), limits)
+    return _limited(_check_tau(tau), checks.array("phi", phi), _checked_body(body), np.sqrt(_check_weights(weights)), limits)
 
 
 def _limited(tau, phi, body: Body, sw, limits: Limits):
@@ -265,7 +280,7 @@ def allocate_least_squares(tau, phi, body: Body, weights=(1.0, 1.0, 0.0),
     Returns (F (N), beta (rad)), beta in (-pi, pi]; F = 0, beta = 0 when u* = 0.
     """
     limits = Limits(force_limit, angle_limit)
-    return _weighted(_check_tau(tau), phi, _checked_body(body), np.sqrt(_check_weights(weights)), limits)
+    return _weighted(_check_tau(tau), checks.array("phi", phi), _checked_body(body), np.sqrt(_check_weights(weights)), limits)
 
 
 def _weighted(tau, phi, body: Body, sw, limits: Limits):

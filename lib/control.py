@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg import expm
 
+from . import checks
 from .allocation import allocate, allocate_least_squares, allocate_limited, residual
 from .angles import wrap_angle
 from .model import input_matrix
@@ -30,6 +31,12 @@ def computed_torque(body: Body, gains: Gains, ref, t, z, dz) -> np.ndarray:
     ``dz`` the actual configuration and its rate, shape (..., 3).
     Returns tau = [tau_x (N), tau_y (N), tau_phi (N m)], shape (..., 3).
     """
+    checks.instance("body", body, Body)
+    checks.instance("gains", gains, Gains)
+    if not all(callable(getattr(ref, k, None)) for k in ("z", "dz", "ddz")):
+        raise TypeError(f"ref must be a reference with z, dz and ddz methods, got {type(ref).__name__}")
+    t = checks.array("t", t)
+    z, dz = checks.array("z", z, shape=(..., 3)), checks.array("dz", dz, shape=(..., 3))
     return computed_torque_from(body, gains, ref.z(t), ref.dz(t), ref.ddz(t), z, dz)
 
 

@@ -17,6 +17,7 @@ from types import MappingProxyType
 import numpy as np
 import pandas as pd
 
+from . import checks
 from .allocation import Allocation, Limits
 from .angles import wrap_angle
 from .closed_loop import ClosedLoop
@@ -30,9 +31,11 @@ __all__ = ["LOOP_VERDICT_DEFAULTS", "closed_loop_verdicts", "held"]
 
 
 def _points(R, Theta, weights):
-    R = np.atleast_1d(np.asarray(R, dtype=float))
-    Theta = np.atleast_1d(np.asarray(Theta, dtype=float))
-    w = np.asarray(weights, dtype=float)
+    R = np.atleast_1d(checks.array("R", R, positive=True))
+    Theta = np.atleast_1d(checks.array("Theta", Theta))
+    w = checks.array("weights", weights, nonnegative=True)
+    if w.ndim == 0 or not np.all(np.any(w > 0, axis=-1)):
+        raise ValueError(f"weights (w_x, w_y, w_phi) must be non-negative and not all zero, got {weights!r}")
     if w.ndim == 1:
         w = np.broadcast_to(w, (max(R.size, Theta.size), 3))
     if R.ndim != 1 or Theta.ndim != 1 or w.ndim != 2 or w.shape[1] != 3:
@@ -45,25 +48,20 @@ def _points(R, Theta, weights):
     except ValueError:
         raise ValueError(f"R ({R.size}), Theta ({Theta.size}) and weights ({w.shape[0]}) must have equal "
                          "lengths (or length 1)") from None
-    if not (np.all(np.isfinite(R)) and np.all(R > 0)):
-        raise ValueError("every R must be a positive finite radius (m)")
-    if not (np.all(np.isfinite(Theta)) and np.all(Theta != 0)):
-        raise ValueError("every Theta must be finite and non-zero (rad/s)")
+    if not np.all(Theta != 0):
+        raise ValueError(f"Theta{list(np.argwhere(Theta == 0)[0])} must be non-zero (rad/s)")
     return R, Theta, w
 
 
 def _check_loop(body, gains, kind, allocation, limits) -> Limits:
     if kind not in KINEMATICS:
         raise ValueError(f"unknown trajectory {kind!r}; known: {sorted(KINEMATICS)}")
-    if not isinstance(body, Body) or not isinstance(gains, Gains):
-        raise TypeError("body must be a lib.params.Body and gains a lib.params.Gains")
+    checks.instance("body", body, Body)
+    checks.instance("gains", gains, Gains)
     if allocation not in ("least_squares", "limited"):
         raise ValueError(f"allocation must be 'least_squares' (limits by projection) or 'limited' (the exact "
                          f"optimum under the limits), got {allocation!r}")
-    limits = Limits() if limits is None else limits
-    if not isinstance(limits, Limits):
-        raise TypeError(f"limits must be a lib.allocation.Limits, got {type(limits).__name__}")
-    return limits
+    return Limits() if limits is None else checks.instance("limits", limits, Limits)
 
 
 #: the default options of :func:`closed_loop_verdicts` (read-only), for the book to quote
@@ -234,18 +232,12 @@ def _loop_options(options: dict) -> dict:
     o = dict(LOOP_VERDICT_DEFAULTS, **options)
     for name, lo in (("steps", 16), ("transient", 1), ("periods", 24), ("block", 2), ("max_period", 1),
                      ("newton_iter", 1)):
-        v = o[name]
-        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
-            raise ValueError(f"{name} must be an integer >= {lo}, got {v!r}")
-        o[name] = int(v)
+        o[name] = checks.integer(name, o[name], minimum=lo)
     if o["periods"] // o["block"] < 3:
         raise ValueError(f"periods ({o['periods']}) must hold at least 3 blocks of {o['block']} periods")
     for name in ("candidate_tol", "newton_tol", "fd_step", "reach_tol", "reach_floor", "lyapunov_band",
                  "slip_band", "position_band", "position_tol", "return_tol", "d0"):
-        v = o[name]
-        if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not (np.isfinite(v) and v > 0):
-            raise ValueError(f"{name} must be a positive finite number, got {v!r}")
-        o[name] = float(v)
+        o[name] = checks.number(name, o[name], positive=True)
     return o
 
 
@@ -320,12 +312,11 @@ def closed_loop_verdicts(body: Body, gains: Gains, kind: str, R, Theta, weights=
     starts = []
     for name, v in (("z0", z0), ("dz0", dz0)):
         if v is not None:
+            v = checks.array(name, v)
             try:
-                v = np.broadcast_to(np.asarray(v, dtype=float), (N, 3))
+                v = np.broadcast_to(v, (N, 3))
             except ValueError:
                 raise ValueError(f"{name} must have shape (3,) or ({N}, 3), got {np.shape(v)}") from None
-            if not np.all(np.isfinite(v)):
-                raise ValueError("the initial state z0, dz0 must be finite")
         starts.append(v)
     w = np.ascontiguousarray(w)
     parts = map_chunks(_verdict_chunk, N, (kinds, R, Theta, w, *starts),

@@ -16,6 +16,7 @@ import numpy as np
 import pandas as pd
 from scipy.optimize import brentq
 
+from . import checks
 from .allocation import Allocation, Limits, allocate
 from .angles import wrap_angle
 from .closed_loop import ClosedLoop, reference_of
@@ -42,6 +43,8 @@ def run(body: Body, gains: Gains, name: str, R: float, theta: float, n_periods: 
     initial state, sampled ``samples_per_period`` times per period. Extra keywords
     go to :func:`lib.simulate.simulate` (e.g. ``limits``, ``integration``)."""
     ref = make(name, R, theta)
+    n_periods = checks.number("n_periods", n_periods, positive=True)
+    samples_per_period = checks.integer("samples_per_period", samples_per_period, minimum=1)
     t_end = n_periods * ref.period
     n = int(round(n_periods * samples_per_period))
     return simulate(body, gains, ref, t_end, t_eval=np.linspace(0.0, t_end, n + 1), **kw)
@@ -154,8 +157,14 @@ def eight_sensitivity(body: Body, gains: Gains, Rs, thetas, *, n_periods: float 
     or, with an ``executor`` (any :class:`concurrent.futures.Executor`, not with
     ``workers`` > 1), the runs go to it in chunks of ``chunk_size``
     (:func:`lib.parallel.map_chunks`). Each run is on its own: the same frame either way."""
-    items = [(body, gains, float(R), float(th), n_periods, n_steady)
-             for R in np.atleast_1d(Rs) for th in np.atleast_1d(thetas)]
+    checks.instance("body", body, Body)
+    checks.instance("gains", gains, Gains)
+    Rs = np.atleast_1d(checks.array("Rs", Rs, positive=True))
+    thetas = np.atleast_1d(checks.array("thetas", thetas))
+    n_periods = checks.number("n_periods", n_periods, positive=True)
+    n_steady = checks.number("n_steady", n_steady, positive=True)
+    workers = checks.integer("workers", workers, minimum=1)
+    items = [(body, gains, float(R), float(th), n_periods, n_steady) for R in Rs for th in thetas]
     if executor is None and chunk_size is None or not items:
         return pd.DataFrame(map_in_processes(_sensitivity_one, items, workers))
     if workers != 1:
@@ -208,13 +217,16 @@ def force_cap_sweep(body: Body, gains: Gains, ref: Reference, caps, *, n_periods
     :class:`concurrent.futures.Executor`) the caps go to it in chunks of ``chunk_size``
     (:func:`lib.parallel.map_chunks`); each run is on its own: the same frame.
     """
-    caps = np.atleast_1d(np.asarray(caps, dtype=float))
-    if caps.ndim != 1 or caps.size == 0 or not np.all(np.isfinite(caps) & (caps > 0)):
-        raise ValueError(f"caps must be positive finite forces (N), got {caps!r}")
-    if not 0 < n_steady < n_periods:
+    caps = np.atleast_1d(checks.array("caps", caps, positive=True))
+    if caps.ndim != 1 or caps.size == 0:
+        raise ValueError(f"caps must be a 1-D array of forces (N), not empty, got {caps!r}")
+    n_periods = checks.integer("n_periods", n_periods, minimum=2)
+    n_steady = checks.integer("n_steady", n_steady, minimum=1)
+    samples_per_period = checks.integer("samples_per_period", samples_per_period, minimum=16)
+    if not n_steady < n_periods:
         raise ValueError(f"need 0 < n_steady < n_periods, got {n_steady!r} and {n_periods!r}")
-    if not isinstance(body, Body) or not isinstance(gains, Gains):
-        raise TypeError("body and gains must be lib.params.Body and lib.params.Gains")
+    checks.instance("body", body, Body)
+    checks.instance("gains", gains, Gains)
     parts = map_chunks(_cap_chunk, caps.size, (caps,), dict(body=body, gains=gains, ref=ref, n_periods=n_periods,
                        n_steady=n_steady, samples_per_period=samples_per_period), executor, chunk_size)
     return concat_frames(parts)

@@ -102,13 +102,13 @@ def test_lean_field_is_the_closed_loop_of_eqs_23_and_2_4():
 @pytest.mark.parametrize("kw,exc,msg", [
     ({"kind": "square"}, ValueError, "unknown trajectory 'square'"),
     ({"kind": ["eight", "circle", "eight"]}, ValueError, "3 entries for 1 points"),
-    ({"R": [-1.0]}, ValueError, "positive finite radius"),
+    ({"R": [-1.0]}, ValueError, r"R\[0\] must be positive"),
     ({"weights": (0.0, 0.0, 0.0)}, ValueError, "not all zero"),
     ({"z0": [1.0, 2.0]}, ValueError, "z0 must have shape"),
     ({"z0": [np.nan, 0.0, 0.0]}, ValueError, "must be finite"),
     ({"periods": 20}, ValueError, "periods must be an integer >= 24"),
     ({"periods": 30, "block": 12}, ValueError, "at least 3 blocks"),
-    ({"newton_tol": 0.0}, ValueError, "newton_tol must be a positive"),
+    ({"newton_tol": 0.0}, ValueError, "newton_tol must be positive"),
     ({"lyapunov": 3}, TypeError, "unknown option"),
     ({"allocation": "exact"}, ValueError, "allocation must be"),
 ])
