@@ -108,13 +108,15 @@ def test_rotation_lyapunov_has_the_sign_of_the_motion(perturb):
     # one point of each sign, in one vectorised run: the paper's eight settles on its
     # period-1 orbit, so its exponent is ln|slowest multiplier| / T; the fast wide eight
     # (R = 3.13 m, Theta = 0.8 rad/s, 'irregular' in Chapter 5) is chaotic, its exponent
-    # positive by a margin (measured 0.22 +- 0.024 1/s over 100 periods: 9 standard errors)
+    # positive by the verdicts' own rule, 3 standard errors (measured 0.18 and 0.20 1/s, 7.3 and
+    # 6.3 SE over 60 periods from the two starts; 5.3 to 8.4 SE over 50 to 80 periods)
     R, Th = np.array([2.0, 3.134615]), np.array([math.pi / 4, 0.8])
     dp0 = perturb(np.zeros(2))
-    ly = rotation.rotation_lyapunov(BODY, "eight", R, Th, periods=80, transient=20, steps=512, p0=dp0)
+    ly = rotation.rotation_lyapunov(BODY, "eight", R, Th, periods=60, transient=20, steps=256, p0=dp0)
     orb = rotation.rotation_orbit(BODY, "eight", R[:1], Th[:1], steps=512)
     expected = math.log(abs(orb.multipliers[0, 0])) * Th[0] / (2 * math.pi)
-    assert ly.value[0] == pytest.approx(expected, abs=6e-4) and ly.value[0] < -10 * ly.stderr[0]  # measured 6.1e-5; reason: < -10 SE is a property
-    assert ly.value[1] > 6 * ly.stderr[1] and ly.value[1] > 0.05
+    assert ly.value[0] == pytest.approx(expected, abs=9e-4)  # measured 8.8e-5 (60 periods, 256 steps)
+    assert ly.value[0] < -6 * ly.stderr[0]  # reason: a property (measured -12 SE)
+    assert ly.value[1] > 3 * ly.stderr[1] and ly.value[1] > 0.05  # reason: a property, margins above
     with pytest.raises(ValueError, match="periods"):
         rotation.rotation_lyapunov(BODY, "eight", R, Th, periods=1)

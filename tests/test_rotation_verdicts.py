@@ -30,20 +30,20 @@ def test_compiled_period_map_matches_numpy_map_and_its_jacobian_finite_differenc
     x = np.array([[2.5, -0.3], [3.0, 0.4], [0.1, 0.0]])
     y, J = _compiled_map(kind, R, Th, n, x)
     y_np, J_np = rotation.rotation_period_map(BODY, kind, R, Th, steps=n)(x)
-    np.testing.assert_allclose(y, y_np, rtol=0, atol=1e-12)
-    np.testing.assert_allclose(J, J_np, rtol=0, atol=1e-11 * max(1.0, np.abs(J_np).max()))
+    np.testing.assert_allclose(y, y_np, rtol=0, atol=7e-13)  # measured 6.6e-14
+    np.testing.assert_allclose(J, J_np, rtol=0, atol=4e-13 * max(1.0, np.abs(J_np).max()))  # measured 3.5e-14 max(1, |J|)
     h = 1e-6
     fd = np.stack([(_compiled_map(kind, R, Th, n, x + h * e)[0] - _compiled_map(kind, R, Th, n, x - h * e)[0])
                    / (2 * h) for e in np.eye(2)], axis=-1)
-    np.testing.assert_allclose(J, fd, rtol=1e-6, atol=1e-7)
+    np.testing.assert_allclose(J, fd, rtol=1e-6, atol=1e-7)  # measured 0.16 of this bound: O(h^2) difference
     # three periods at once are three maps in a row, the Jacobian by the chain rule
     y3, J3 = _compiled_map(kind, R, Th, n, x, periods=3)
     z, Jz = x, np.tile(np.eye(2), (3, 1, 1))
     for _ in range(3):
         z, Jk = _compiled_map(kind, R, Th, n, z)
         Jz = Jk @ Jz
-    np.testing.assert_allclose(y3, z, rtol=0, atol=1e-12)
-    np.testing.assert_allclose(J3, Jz, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(y3, z, rtol=0, atol=1e-14)  # measured 0
+    np.testing.assert_allclose(J3, Jz, rtol=2e-13, atol=2e-15)  # measured 0.09 of this bound (1.6e-10 at |J| up to 1e4)
 
 
 def _full_loop_period(R, Th, p, dp, periods=1, steps=512):
@@ -62,20 +62,20 @@ def test_paper_eight_is_period_one_and_its_orbit_is_an_orbit_of_the_full_closed_
     df = verdicts.eight_rotation_sweep(BODY, [EIGHT[0]], [EIGHT[1]], p0=p0)
     row = df.iloc[0]
     assert row.regime == "periodic" and row.period == 1 and not row.lost
-    assert 0.92 < row.floquet < 0.945 and row.residual <= 1e-10
+    assert 0.92 < row.floquet < 0.945 and row.residual <= 1e-10  # measured 1.2e-14; reason: the residual within the verdicts' newton_tol
     # the orbit itself: started on it, the full closed loop (solve_ivp) comes back after one period
     orb = attractor.rotation_attractor(BODY, "eight", *EIGHT, p0=p0)
-    assert abs(orb.multipliers[0]) == pytest.approx(row.floquet, rel=1e-9) and abs(orb.multipliers[1]) < 0.01
+    assert abs(orb.multipliers[0]) == pytest.approx(row.floquet, rel=1e-13) and abs(orb.multipliers[1]) < 0.01  # measured 0; reason: < 0.01 is a property
     t, p, dp = _full_loop_period(*EIGHT, *orb.states[0])
-    assert abs(p[-1] - p[0]) < 1e-7
+    assert abs(p[-1] - p[0]) < 1e-10  # measured 1.0e-11
     r_ref = rotation.sampled_range(p[None, 1:], dy=dp[None, 1:], h=2 * math.pi / 512)[0]   # Hermite-refined
-    assert r_ref == pytest.approx(row["range"], abs=1e-6)
-    assert orb.range == pytest.approx(row["range"], abs=1e-12)
+    assert r_ref == pytest.approx(row["range"], abs=5e-7)  # measured 5.4e-8
+    assert orb.range == pytest.approx(row["range"], abs=1e-14)  # measured 0
     from scipy.interpolate import CubicSpline
 
-    assert CubicSpline(orb.t, orb.p)(t) == pytest.approx(p, abs=1e-5)    # the orbit's p(t) is the loop's
+    assert CubicSpline(orb.t, orb.p)(t) == pytest.approx(p, abs=4e-6)    # measured 4.1e-7: spline interpolation; the orbit's p(t) is the loop's
     # Lyapunov exponent of an orbit: ln of its slowest multiplier per period, negative
-    assert row.lyapunov == pytest.approx(math.log(row.floquet) * EIGHT[1] / (2 * math.pi), rel=1e-12)
+    assert row.lyapunov == pytest.approx(math.log(row.floquet) * EIGHT[1] / (2 * math.pi), rel=1e-13, abs=0)  # measured 0
 
 
 def test_the_eight_has_two_mirror_image_orbits_and_each_start_reaches_its_own():
@@ -83,25 +83,25 @@ def test_the_eight_has_two_mirror_image_orbits_and_each_start_reaches_its_own():
     b = attractor.rotation_attractor(BODY, "eight", *EIGHT, p0=1.0)
     c = attractor.rotation_attractor(BODY, "eight", *EIGHT, p0=-1.0)
     assert abs(a.states[0, 0] - b.states[0, 0]) > 0.1                  # two different orbits
-    np.testing.assert_allclose(b.states, c.states, atol=1e-9)           # +-1 reach the same one
-    np.testing.assert_allclose(np.abs(a.multipliers), np.abs(b.multipliers), rtol=1e-8)
-    assert a.range == pytest.approx(b.range, abs=1e-9)
+    np.testing.assert_allclose(b.states, c.states, rtol=0, atol=4e-12)           # measured 3.6e-13; +-1 reach the same one
+    np.testing.assert_allclose(np.abs(a.multipliers), np.abs(b.multipliers), rtol=1.5e-11)  # measured 1.6e-12
+    assert a.range == pytest.approx(b.range, abs=4e-14)  # measured 3.6e-15
     # mirror images: the extremes swap sign
-    assert a.p.max() == pytest.approx(-b.p.min(), abs=1e-6) and a.p.min() == pytest.approx(-b.p.max(), abs=1e-6)
+    assert a.p.max() == pytest.approx(-b.p.min(), abs=6e-14) and a.p.min() == pytest.approx(-b.p.max(), abs=6e-14)  # measured 5.8e-15
 
 
 def test_slipping_point_loses_one_turn_per_period_as_the_full_closed_loop_does(perturb):
     p0 = float(perturb([0.0])[0])
     row = verdicts.eight_rotation_sweep(BODY, [SLIPPING[0]], [SLIPPING[1]], p0=p0).iloc[0]
     assert row.regime == "slipping" and row.period == 1 and row.lost
-    assert row.slip == pytest.approx(1.0, abs=1e-12) and row.floquet < 0.9
+    assert row.slip == pytest.approx(1.0, abs=1e-14) and row.floquet < 0.9  # measured 0; reason: floquet < 0.9 is a property
     # solve_ivp on the full closed loop from the reference start: after the verdict's periods
     # p advances by the same whole turns every period
     n = int(row.periods) + 4
     t, p, _ = _full_loop_period(*SLIPPING, p0, 0.0, periods=n, steps=64)
     per = p[64::64]
     d = np.diff(per[-4:])
-    np.testing.assert_allclose(d, 2 * np.pi * row.slip, atol=1e-4)
+    np.testing.assert_allclose(d, 2 * np.pi * row.slip, atol=1e-4)  # measured 3.8e-5: solve_ivp at its default tolerances
 
 
 def test_period_three_orbit_is_found_and_is_an_orbit(perturb):
@@ -117,8 +117,8 @@ def test_period_three_orbit_is_found_and_is_an_orbit(perturb):
     for _ in range(3):
         x, _ = step(x)
         xs.append(x[0])
-    assert np.abs(xs[-1] - x0[0]).max() < 1e-9                         # numpy map: period 3
-    assert np.abs(xs[0] - x0[0]).max() > 1e-3                          # and not period 1
+    assert np.abs(xs[-1] - x0[0]).max() < 2e-13                         # measured 1.8e-14; numpy map: period 3
+    assert np.abs(xs[0] - x0[0]).max() > 1e-3                          # reason: a property (measured 6.8); and not period 1
 
 
 def test_chaotic_point_has_a_positive_lyapunov_exponent(perturb):
@@ -134,7 +134,7 @@ def test_chaotic_exponent_is_that_of_the_numpy_reference():
     # the verdict's exponent against rotation.rotation_lyapunov (numpy, same scheme), once:
     # the verdict's robustness to the start is the test above
     row = verdicts.eight_rotation_sweep(BODY, [CHAOTIC[0]], [CHAOTIC[1]]).iloc[0]
-    ref = rotation.rotation_lyapunov(BODY, "eight", [CHAOTIC[0]], [CHAOTIC[1]], periods=100, transient=20,
+    ref = rotation.rotation_lyapunov(BODY, "eight", [CHAOTIC[0]], [CHAOTIC[1]], periods=60, transient=20,
                                      steps=int(row.steps))
     assert abs(row.lyapunov - ref.value[0]) < 4 * math.hypot(row.lyapunov_stderr, 2 * ref.stderr[0])
 
@@ -156,7 +156,7 @@ def test_sweep_columns_and_the_lost_definition(perturb):
     # the chaotic point turns right round without a net drift: not lost, but it turns round
     assert df.lost.tolist() == [False, False, True, False, False]
     assert df.turns_round.tolist()[:3] == [False, True, True]
-    assert (df.floquet[orbit] < 1).all() and (df.residual[orbit] <= 1e-10).all()
+    assert (df.floquet[orbit] < 1).all() and (df.residual[orbit] <= 1e-10).all()  # reason: the residual within the verdicts' newton_tol
 
 
 def test_engines_agree_on_the_verdicts():
@@ -164,8 +164,8 @@ def test_engines_agree_on_the_verdicts():
     a = verdicts.eight_rotation_sweep(BODY, R, Th, max_periods=20)
     b = verdicts.eight_rotation_sweep(BODY, R, Th, max_periods=20, engine="numpy")
     assert list(a.regime) == list(b.regime) == ["periodic", "slipping"]
-    np.testing.assert_allclose(a["range"], b["range"], atol=1e-9)
-    np.testing.assert_allclose(a.floquet, b.floquet, rtol=1e-8)
+    np.testing.assert_allclose(a["range"], b["range"], rtol=0, atol=1e-12)  # measured 8.5e-14
+    np.testing.assert_allclose(a.floquet, b.floquet, rtol=7e-12)  # measured 6.7e-13
 
 
 @pytest.mark.parametrize("kwargs, exc, match", [
@@ -216,8 +216,8 @@ def test_orbits_are_measured_on_the_fine_map_whatever_the_verdict_map():
     b = verdicts.eight_rotation_sweep(BODY, R, Th, h_verdict=0.125)
     assert (a.verdict_steps < a.steps).all() and (b.verdict_steps == b.steps).all()
     assert list(a.regime) == list(b.regime) and list(a.period) == list(b.period)
-    np.testing.assert_allclose(a["range"], b["range"], atol=1e-9)
-    np.testing.assert_allclose(a.floquet, b.floquet, rtol=1e-8)
+    np.testing.assert_allclose(a["range"], b["range"], rtol=0, atol=1e-10)  # measured 1.1e-13; reason: newton_tol (1e-10) bounds it
+    np.testing.assert_allclose(a.floquet, b.floquet, rtol=1e-8)  # measured 8.9e-13; reason: orbits equal to newton_tol
 
 
 def test_distance_to_an_orbit_is_zero_on_it_and_the_offset_off_it():
@@ -225,8 +225,8 @@ def test_distance_to_an_orbit_is_zero_on_it_and_the_offset_off_it():
     T = float(orb.t[-1])
     t = np.concatenate([orb.t[:-1] + j * T for j in range(3)])
     p = np.tile(orb.p[:-1], 3) + 2 * np.pi      # a whole turn away is the same heading
-    np.testing.assert_allclose(orb.distance_per_period(t, p), 0.0, atol=1e-9)
-    np.testing.assert_allclose(orb.distance_per_period(t, p + 0.1), 0.1, atol=1e-9)
+    np.testing.assert_allclose(orb.distance_per_period(t, p), 0.0, rtol=0, atol=4e-14)  # measured 3.6e-15
+    np.testing.assert_allclose(orb.distance_per_period(t, p + 0.1), 0.1, rtol=0, atol=4e-14)  # measured 3.2e-15
     with pytest.raises(ValueError, match="full reference period"):
         orb.distance_per_period(orb.t[:10], orb.p[:10])
     with pytest.raises(ValueError, match="equal length"):
@@ -276,26 +276,27 @@ def test_zero_exponent_without_a_closed_section_is_undecided_not_quasiperiodic()
     assert abs(row.lyapunov) * 2 * math.pi / 0.826263 <= 0.01
 
 
-@pytest.mark.parametrize("point, regime", [(CHAOTIC, "chaotic"), (EIGHT, "periodic")])
-def test_chaos_and_contraction_are_those_of_the_full_closed_loop(point, regime):
+@pytest.mark.parametrize("point, regime, periods", [(CHAOTIC, "chaotic", 12), (EIGHT, "periodic", 20)])
+def test_chaos_and_contraction_are_those_of_the_full_closed_loop(point, regime, periods):
     # an independent route: two solve_ivp runs of the full 6-state closed loop, the heading
-    # started 1e-9 rad apart, over 20 periods. Chaos (lambda T ~ 1.7 here) separates them
-    # to order one (e^(0.22 * 157) * 1e-9 ~ 1e6); an attracting orbit (|mu_1| = 0.93)
-    # brings them closer (0.93^20 ~ 0.23, times 1e-9). The margins (1e6 and 4x) need no
-    # robustness rerun: the 1e-9 offset is itself a perturbation far above the last bits.
+    # started 1e-9 rad apart. Chaos (lambda T ~ 1.6 here) separates them to order one within
+    # 12 periods (measured: past 1e-2 after 8.2 periods, 1.27 rad at most over the last two);
+    # an attracting orbit (|mu_1| = 0.93) brings them closer over 20 (0.93^20 ~ 0.23, times
+    # 1e-9). The margins (100x and 10x) need no robustness rerun: the 1e-9 offset is itself a
+    # perturbation far above the last bits.
     p0 = 0.0
     row = verdicts.eight_rotation_sweep(BODY, [point[0]], [point[1]], p0=p0).iloc[0]
     assert row.regime == regime
     ref = trajectories.eight(*point)
     T = 2 * math.pi / point[1]
-    t = np.linspace(0.0, 20 * T, 401)
+    t = np.linspace(0.0, periods * T, 20 * periods + 1)
     runs = [simulate.simulate(BODY, Gains(), ref, float(t[-1]), z0=ref.z(0.0) + [0, 0, p0 + dp],
                               dz0=ref.dz(0.0), t_eval=t).rotation_error() for dp in (0.0, 1e-9)]
     sep = np.abs(runs[1] - runs[0])
     if regime == "chaotic":
-        assert sep[-40:].max() > 1e-2
+        assert sep[-40:].max() > 1e-2  # reason: a property, the runs part (measured 1.27)
     else:
-        assert sep[-1] < 1e-9
+        assert sep[-1] < 2e-10  # measured 1.9e-11
 
 
 def test_mirror_distance_separates_symmetric_orbits_from_mirror_pairs():
@@ -303,11 +304,11 @@ def test_mirror_distance_separates_symmetric_orbits_from_mirror_pairs():
     # (its mirror image is the second attractor of Chapter 3), a slow wide eight a symmetric one
     df = verdicts.eight_rotation_sweep(BODY, [EIGHT[0], 2.0], [EIGHT[1], 0.1])
     assert list(df.regime) == ["periodic", "periodic"]
-    assert df.mirror[0] > 0.1 and df.mirror[1] < 1e-9
+    assert df.mirror[0] > 0.1 and df.mirror[1] < 5e-14  # measured 5.1e-15; reason: > 0.1 is a property (measured 0.80)
     a = attractor.rotation_attractor(BODY, "eight", *EIGHT, p0=0.0)
     b = attractor.rotation_attractor(BODY, "eight", *EIGHT, p0=1.0)
     # the mirror distance at s = 0 is the distance from one orbit's point to the other's
-    assert abs(a.states[0, 0] - b.states[0, 0]) <= df.mirror[0] + 1e-9
+    assert abs(a.states[0, 0] - b.states[0, 0]) <= df.mirror[0] + 1e-9  # reason: a property (measured 0.16 against 0.80)
     assert attractor.map_summary(df).n_asymmetric == 1
     circle = verdicts.rotation_verdicts(BODY, "circle", [2.0], [math.pi / 4])
     assert circle.regime[0] == "periodic" and np.isnan(circle.mirror[0])
