@@ -107,7 +107,7 @@ def test_simulation_decays_below_the_limit_and_leaves_above(limit):
         circle_steady_state(BODY, GAINS, R, THETA, (1.0, 1.0, 1.03 * limit.w_phi))
     ref = limit.steady.state
     dev = np.abs(_flow(1.03 * limit.w_phi, ref + d0, 30.0, tol=1e-9) - ref)[:, :3].max()
-    assert dev > 100 * 1e-3
+    assert dev > 100 * 1e-3  # reason: a property (measured 7.9)
 
 
 @pytest.mark.parametrize("w_phi", [0.0, 1.0, 3.0])
