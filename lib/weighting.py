@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from . import checks
 from .allocation import Allocation, Limits
 from .angles import wrap_angle
 from .closed_loop import ClosedLoop
@@ -117,15 +118,14 @@ def closed_loop_batch(body: Body, gains: Gains, kind: str, R, Theta, weights=(1.
     adaptive :func:`lib.simulate.simulate` (within 1e-5) and Chapter 6's 40 ms runs with 20 ms.
     """
     limits = _check_loop(body, gains, kind, allocation, limits)
-    for name, v in (("t_end", t_end), ("dt", dt), ("record_dt", record_dt)):
-        if not np.isfinite(v) or v <= 0:
-            raise ValueError(f"{name} must be a positive finite time (s), got {v!r}")
+    t_end, dt, record_dt = (checks.number(n, v, positive=True, unit="s")
+                            for n, v in (("t_end", t_end), ("dt", dt), ("record_dt", record_dt)))
     R, Theta, w = _points(R, Theta, weights)
     kin = KINEMATICS[kind]
     loop = ClosedLoop.of(body, gains, lambda t: kin(R, Theta, t), Allocation(allocation, w), limits)
     zd0, dzd0, _ = kin(R, Theta, 0.0)
-    z0 = zd0 if z0 is None else np.broadcast_to(np.asarray(z0, dtype=float), zd0.shape)
-    dz0 = dzd0 if dz0 is None else np.broadcast_to(np.asarray(dz0, dtype=float), dzd0.shape)
+    z0 = zd0 if z0 is None else np.broadcast_to(checks.array("z0", z0), zd0.shape)
+    dz0 = dzd0 if dz0 is None else np.broadcast_to(checks.array("dz0", dz0), dzd0.shape)
     n_steps = int(np.ceil(t_end / dt))
     every = max(1, int(round(record_dt / (t_end / n_steps))))
     try:
@@ -255,8 +255,7 @@ def compare_on_map(body: Body, gains: Gains, R, Theta, w_phi: float, **options) 
     """Classify the paper's law (w_phi = 0, exactly (25)-(26)) and the weighted law (weights
     (1, 1, ``w_phi``)) on the eight at the points (R_i (m), Theta_i (rad/s)), both started on
     the reference, by one call of :func:`closed_loop_verdicts` (``options`` go there)."""
-    if isinstance(w_phi, bool) or not np.isscalar(w_phi) or not np.isfinite(w_phi) or w_phi <= 0:
-        raise ValueError(f"w_phi must be a positive finite weight, got {w_phi!r}")
+    w_phi = checks.number("w_phi", w_phi, positive=True)
     R, Theta, _ = _points(R, Theta, (1.0, 1.0, 0.0))
     f = verdict_runs(body, gains, {"paper": dict(kind="eight", R=R, Theta=Theta, weights=(1.0, 1.0, 0.0)),
                                    "weighted": dict(kind="eight", R=R, Theta=Theta, weights=(1.0, 1.0, w_phi))},

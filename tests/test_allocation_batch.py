@@ -55,7 +55,7 @@ def test_steady_metrics_need_enough_periods():
 @pytest.mark.parametrize("kw,exc,msg", [
     ({"kind": "square"}, ValueError, "unknown trajectory 'square'"),
     ({"R": []}, ValueError, "empty"),
-    ({"R": [1.0, -1.0]}, ValueError, "positive finite radius"),
+    ({"R": [1.0, -1.0]}, ValueError, r"R\[1\] must be positive"),
     ({"Theta": [0.0]}, ValueError, "non-zero"),
     ({"R": [1.0, 2.0], "Theta": [1.0, 2.0, 3.0]}, ValueError, "equal lengths"),
     ({"weights": (0.0, 0.0, 0.0)}, ValueError, "not all zero"),
@@ -95,7 +95,7 @@ def test_map_comparison_classifies_both_laws_by_one_verdict():
     assert cmp.held[0] and cmp.weighted.pos_rms.iloc[0] < 0.05
     with pytest.raises(ValueError, match="R"):
         weighting.compare_on_map(Body(), Gains(), [-1.0], [0.3], 0.1)
-    with pytest.raises(ValueError, match="w_phi must be a positive"):
+    with pytest.raises(ValueError, match="w_phi must be positive"):
         weighting.compare_on_map(Body(), Gains(), [1.0], [0.3], 0.0)
 
 
