@@ -117,7 +117,7 @@ def _check_sweep(body, gains, ref, angle_limits, force_limit, **numbers) -> np.n
 
 def section_sweep(body: Body, gains: Gains, ref: Reference, angle_limits, *, force_limit=None,
                   n_transient: int = 20, n_points: int = 24, rtol: float = 1e-8, atol: float = 1e-8,
-                  z0=None, dz0=None, workers: int = 1) -> list[np.ndarray]:
+                  z0=None, dz0=None, workers: int = 1, progress: bool | None = None) -> list[np.ndarray]:
     """Bifurcation data: the stroboscopic section (:func:`stroboscopic_section`,
     ``n_points`` error states after ``n_transient`` periods) for each angle limit (rad),
     from the paper's initial state unless ``z0``/``dz0`` are given; ``workers``
@@ -126,13 +126,13 @@ def section_sweep(body: Body, gains: Gains, ref: Reference, angle_limits, *, for
                           n_points=n_points, rtol=rtol, atol=atol)
     s0 = _start(z0, dz0)
     items = [(body, gains, ref, float(b), force_limit, n_transient, n_points, rtol, atol, s0) for b in angles]
-    return map_in_processes(_section_one, items, workers)
+    return map_in_processes(_section_one, items, workers, progress)
 
 
 def sweep_angle_limit(body: Body, gains: Gains, ref: Reference, angle_limits, *, force_limit=None,
                       n_transient: int = 30, n_points: int = 40, n_lyap: int = 40, tol: float = 1e-4,
                       rtol: float = 1e-10, atol: float = 1e-10, d0: float = 1e-5, z0=None, dz0=None,
-                      workers: int = 1) -> list[Regime]:
+                      workers: int = 1, progress: bool | None = None) -> list[Regime]:
     """Classify the long-run regime for each angle limit (rad).
 
     For each limit: ``n_transient`` periods are discarded, ``n_points`` section
@@ -145,7 +145,7 @@ def sweep_angle_limit(body: Body, gains: Gains, ref: Reference, angle_limits, *,
     s0 = _start(z0, dz0)
     items = [(body, gains, ref, float(b), force_limit, n_transient, n_points, n_lyap, tol, rtol, atol, d0, s0)
              for b in angles]
-    return map_in_processes(_regime_one, items, workers)
+    return map_in_processes(_regime_one, items, workers, progress)
 
 
 def _regime_one(args) -> Regime:
@@ -205,7 +205,7 @@ class _SwitchedMap:
 
 def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force_limits=None, *, s0=None,
                    steps_per_period: int = STEPS_PER_PERIOD, executor=None, chunk_size: int | None = None,
-                   **options):
+                   progress: bool | None = None, **options):
     """Decide the long-run regime of the switched closed loop for each (angle limit (rad),
     force limit (N)) pair by the book's one decision procedure (:mod:`lib.dynamics.verdicts`)
     on the full state. Options (:data:`LIMIT_DEFAULTS`): ``transient`` periods dropped,
@@ -243,6 +243,8 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
     :func:`lib.parallel.map_chunks`; each run is decided on its own, so the frame is the one
     of the single call, and the runs' arrays are concatenated in order into one
     :class:`SwitchedRuns`.
+    ``progress``: a bar over the pairs on stderr (:func:`lib.parallel.show_progress`; default None: only when run
+    interactively, never under pytest or in the book build).
 
     Returns (a DataFrame with one row per pair, the :class:`SwitchedRuns`)."""
     unknown = set(options) - set(LIMIT_DEFAULTS)
@@ -261,7 +263,7 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
     S0 = _start_states(s0, b.size)
     parts = map_chunks(_limit_chunk, b.size, (b, f, S0), dict(body=body, gains=gains, ref=ref, o=o,
                                                              steps_per_period=steps_per_period),
-                       executor, chunk_size)
+                       executor, chunk_size, progress)
     if len(parts) == 1:
         return parts[0]
     return pd.concat([p[0] for p in parts], ignore_index=True), _concat_runs([p[1] for p in parts])

@@ -243,7 +243,8 @@ def _loop_options(options: dict) -> dict:
 
 def closed_loop_verdicts(body: Body, gains: Gains, kind: str, R, Theta, weights=(1.0, 1.0, 0.0), *,
                          z0=None, dz0=None, allocation: str = "least_squares", limits: Limits | None = None,
-                         executor=None, chunk_size: int | None = None, **options) -> pd.DataFrame:
+                         executor=None, chunk_size: int | None = None, progress: bool | None = None,
+                         **options) -> pd.DataFrame:
     """The verdict of Chapter 5 (:data:`lib.dynamics.verdicts.REGIMES`, and ``lost``) for the full
     six-state closed loop (2)-(4), (23) with the weighted allocation (weights (w_x, w_y, w_phi) per
     point; w_phi = 0 is exactly the paper's law (25)-(26)), on ``kind`` ("eight" (28) or "circle"
@@ -296,6 +297,8 @@ def closed_loop_verdicts(body: Body, gains: Gains, kind: str, R, Theta, weights=
     :func:`lib.parallel.map_chunks`. The field (lean or through :class:`ClosedLoop`) is chosen
     once for all points of the call and every point is decided on its own, so the frame is
     the one of the single call.
+    ``progress``: a bar over the points on stderr (:func:`lib.parallel.show_progress`; default None: only when run
+    interactively, never under pytest or in the book build).
     """
     kinds = np.atleast_1d(np.asarray(kind, dtype=object))
     if kinds.ndim != 1 or kinds.size == 0:
@@ -321,7 +324,7 @@ def closed_loop_verdicts(body: Body, gains: Gains, kind: str, R, Theta, weights=
     w = np.ascontiguousarray(w)
     parts = map_chunks(_verdict_chunk, N, (kinds, R, Theta, w, *starts),
                        dict(body=body, gains=gains, allocation=allocation, limits=limits, o=o,
-                            lean=_lean(allocation, limits, w)), executor, chunk_size)
+                            lean=_lean(allocation, limits, w)), executor, chunk_size, progress)
     return concat_frames(parts)
 
 

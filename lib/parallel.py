@@ -3,6 +3,9 @@
 ``Client.get_executor()``), and the slow one-run-at-a-time integrations (the adaptive
 switched integrator, the adaptive tracking runs) in a pool of processes.
 
+A sweep reports its progress (a tqdm bar on stderr, in points) when run interactively;
+see :func:`show_progress`.
+
 Processes are *spawned*, never forked: numba's threads (the compiled engines run
 ``prange`` loops over points) make a fork of the parent unsafe once they have run
 ("fork() called from a process already using GNU OpenMP"). A function sent to another
@@ -14,18 +17,58 @@ from __future__ import annotations
 import math
 import multiprocessing
 import os
-from concurrent.futures import Executor, ProcessPoolExecutor
+import sys
+from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
 from typing import Callable, Sequence
 
 import pandas as pd
 
-__all__ = ["map_in_processes", "process_pool", "map_chunks", "chunk_slices", "executor_workers", "concat_frames"]
+from . import checks
+
+__all__ = ["map_in_processes", "process_pool", "map_chunks", "chunk_slices", "executor_workers", "concat_frames",
+           "show_progress", "PROGRESS_CHUNKS"]
+
+#: with progress shown and no ``chunk_size`` nor executor, a sweep runs in about this many
+#: chunks one after another, so that the bar moves (the frame is the same: every point is
+#: decided on its own)
+PROGRESS_CHUNKS = 20
 
 
 def _check_workers(workers) -> int:
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise ValueError(f"workers must be a positive integer, got {workers!r}")
-    return workers
+    return checks.integer("workers", workers, minimum=1)
+
+
+def show_progress(progress: bool | None = None) -> bool:
+    """Whether a sweep reports its progress on stderr.
+
+    Parameters
+    ----------
+    progress : bool or None
+        True or False decides; None (the default of every sweep) means: only when run
+        interactively, that is when stderr is a terminal and the code is not running under
+        pytest (``PYTEST_CURRENT_TEST`` set) or in a notebook kernel (the book build, whose
+        stderr is not a terminal). In a notebook of your own, pass ``progress=True``.
+
+    Returns
+    -------
+    bool
+        True if a progress bar is to be shown.
+    """
+    if progress is not None:
+        return checks.flag("progress", progress)
+    if "PYTEST_CURRENT_TEST" in os.environ:
+        return False
+    try:
+        return bool(sys.stderr.isatty())
+    except (AttributeError, ValueError):   # no stderr, or a closed one
+        return False
+
+
+def _bar(total: int, desc: str | None):
+    """A tqdm bar over ``total`` points on stderr (tqdm imported only when a bar is shown)."""
+    from tqdm.auto import tqdm
+
+    return tqdm(total=total, desc=desc, unit="pt", file=sys.stderr, dynamic_ncols=True)
 
 
 def process_pool(workers: int) -> ProcessPoolExecutor:
@@ -33,14 +76,44 @@ def process_pool(workers: int) -> ProcessPoolExecutor:
     return ProcessPoolExecutor(max_workers=_check_workers(workers), mp_context=multiprocessing.get_context("spawn"))
 
 
-def map_in_processes(fn: Callable, items: Sequence, workers: int) -> list:
+def map_in_processes(fn: Callable, items: Sequence, workers: int, progress: bool | None = None) -> list:
     """``[fn(x) for x in items]``, shared among ``workers`` spawned processes when more than
-    one (``fn`` must be a module-level function, so that it can be sent to them)."""
+    one (``fn`` must be a module-level function, so that it can be sent to them).
+
+    Parameters
+    ----------
+    fn : callable
+        A module-level function of one item.
+    items : sequence
+        The items, one call each.
+    workers : int
+        Processes (>= 1); 1 runs the items here, one after another.
+    progress : bool or None
+        Show a progress bar over the items (:func:`show_progress`; None: only interactively).
+
+    Returns
+    -------
+    list
+        ``fn(x)`` for each item, in order.
+    """
     _check_workers(workers)
-    if workers == 1 or len(items) <= 1:
-        return [fn(x) for x in items]
-    with process_pool(min(workers, len(items))) as ex:
-        return list(ex.map(fn, items))
+    if not show_progress(progress):
+        if workers == 1 or len(items) <= 1:
+            return [fn(x) for x in items]
+        with process_pool(min(workers, len(items))) as ex:
+            return list(ex.map(fn, items))
+    with _bar(len(items), getattr(fn, "__name__", None)) as bar:
+        if workers == 1 or len(items) <= 1:
+            out = []
+            for x in items:
+                out.append(fn(x))
+                bar.update(1)
+            return out
+        with process_pool(min(workers, len(items))) as ex:
+            futures = [ex.submit(fn, x) for x in items]
+            for f in as_completed(futures):
+                bar.update(1)
+            return [f.result() for f in futures]
 
 
 def executor_workers(executor: Executor) -> int:
@@ -63,19 +136,16 @@ def chunk_slices(n: int, chunk_size: int) -> list[slice]:
 
 
 def _check_chunking(n, executor, chunk_size) -> int | None:
-    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-        raise ValueError(f"n must be a positive integer (the points), got {n!r}")
+    checks.integer("n", n, minimum=1)
     if executor is not None and not isinstance(executor, Executor):
         raise TypeError(f"executor must be a concurrent.futures.Executor (e.g. a process pool, or a dask "
                         f"Client.get_executor()), got {type(executor).__name__}")
-    if chunk_size is not None and (isinstance(chunk_size, bool) or not isinstance(chunk_size, int)
-                                   or chunk_size < 1):
-        raise ValueError(f"chunk_size must be a positive integer or None, got {chunk_size!r}")
-    return chunk_size
+    return None if chunk_size is None else checks.integer("chunk_size", chunk_size, minimum=1)
 
 
 def map_chunks(fn: Callable, n: int, arrays: Sequence, kwargs: dict | None = None,
-               executor: Executor | None = None, chunk_size: int | None = None) -> list:
+               executor: Executor | None = None, chunk_size: int | None = None,
+               progress: bool | None = None) -> list:
     """The one scatter and gather of the sweeps: cut the first axis (length ``n``, the points)
     of each of ``arrays`` (arrays or lists; a None passes to every chunk as None) into
     consecutive chunks of ``chunk_size`` points, call ``fn(*chunk, **kwargs)`` on each,
@@ -85,21 +155,76 @@ def map_chunks(fn: Callable, n: int, arrays: Sequence, kwargs: dict | None = Non
     ``chunk_size`` defaults to ceil(n / (2 workers)) with an executor (two chunks per worker,
     :func:`executor_workers`), and to all n points without one: then ``fn`` runs once, here,
     on the arrays as given. ``fn`` must be module-level and its arguments picklable. If a
-    chunk raises, the chunks not yet started are cancelled and the error is raised here."""
+    chunk raises, the chunks not yet started are cancelled and the error is raised here.
+
+    ``progress``: a bar over the points, advanced as each chunk returns
+    (:func:`show_progress`: None shows it only interactively, never under pytest or in the
+    book build). With the bar and neither ``chunk_size`` nor an executor, the points run
+    here in about :data:`PROGRESS_CHUNKS` chunks, so that the bar moves.
+
+    Parameters
+    ----------
+    fn : callable
+        A module-level function ``fn(*chunk_arrays, **kwargs)``.
+    n : int
+        The number of points (the first axis of every array).
+    arrays : sequence
+        Arrays or lists of ``n`` entries each, or None.
+    kwargs : dict, optional
+        Keywords passed to every call, the same for all chunks.
+    executor : concurrent.futures.Executor, optional
+        Where the chunks run (its ``submit``); None runs them here.
+    chunk_size : int, optional
+        Points per chunk (see above for the default).
+    progress : bool or None
+        Show a progress bar (see above).
+
+    Returns
+    -------
+    list
+        ``fn``'s result for each chunk, in the order of the chunks.
+    """
     kwargs = {} if kwargs is None else kwargs
     _check_chunking(n, executor, chunk_size)
     for a in arrays:
         if a is not None and len(a) != n:
             raise ValueError(f"every array must have the n = {n} points on its first axis, got {len(a)}")
+    bar = _bar(n, getattr(fn, "__name__", "").strip("_") or None) if show_progress(progress) else None
     if chunk_size is None:
-        chunk_size = n if executor is None else math.ceil(n / (2 * executor_workers(executor)))
+        if executor is not None:
+            chunk_size = math.ceil(n / (2 * executor_workers(executor)))
+        else:
+            chunk_size = n if bar is None else math.ceil(n / PROGRESS_CHUNKS)
+    try:
+        return _run_chunks(fn, n, arrays, kwargs, executor, chunk_size, bar)
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+def _run_chunks(fn, n, arrays, kwargs, executor, chunk_size, bar) -> list:
+    """The chunks of :func:`map_chunks`, run here or through ``executor``, advancing ``bar``."""
+    def tick(k: int) -> None:
+        if bar is not None:
+            bar.update(k)
+
     if chunk_size >= n and executor is None:
-        return [fn(*arrays, **kwargs)]
+        out = [fn(*arrays, **kwargs)]
+        tick(n)
+        return out
     slices = chunk_slices(n, chunk_size)
     if executor is None:
-        return [fn(*_cut(arrays, s), **kwargs) for s in slices]
+        out = []
+        for s in slices:
+            out.append(fn(*_cut(arrays, s), **kwargs))
+            tick(s.stop - s.start)
+        return out
     futures = [executor.submit(fn, *_cut(arrays, s), **kwargs) for s in slices]
+    size = {f: s.stop - s.start for f, s in zip(futures, slices)}
     try:
+        for f in as_completed(futures):
+            f.result()
+            tick(size[f])
         return [f.result() for f in futures]
     except BaseException:
         for f in futures:

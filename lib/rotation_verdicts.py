@@ -51,13 +51,15 @@ def eight_rotation_sweep(body: Body, R, Theta, **options) -> pd.DataFrame:
 FIG5_GRID = MappingProxyType(dict(R=(0.25, 4.0), Theta=(0.05, 1.5), n=100))
 
 
-def fig5_map(body: Body, n: int = FIG5_GRID["n"], *, executor=None, chunk_size: int | None = None) -> pd.DataFrame:
+def fig5_map(body: Body, n: int = FIG5_GRID["n"], *, executor=None, chunk_size: int | None = None,
+             progress: bool | None = None) -> pd.DataFrame:
     """The book's Fig. 5 (Chapter 5, and the report's row on it): :func:`eight_rotation_sweep`
     on the n x n grid :data:`FIG5_GRID`, Theta varying slowest; ``executor`` and
     ``chunk_size`` as there (the same frame, computed elsewhere in chunks)."""
     n = _check_int("n", n, 2)
     R, Th = np.meshgrid(np.linspace(*FIG5_GRID["R"], n), np.linspace(*FIG5_GRID["Theta"], n))
-    return eight_rotation_sweep(body, R.ravel(), Th.ravel(), executor=executor, chunk_size=chunk_size)
+    return eight_rotation_sweep(body, R.ravel(), Th.ravel(), executor=executor, chunk_size=chunk_size,
+                                progress=progress)
 
 
 def _check_body_kind(body, kind):
@@ -109,7 +111,7 @@ def _verdict_options(options: dict) -> dict:
 
 def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lambda: float = 0.125,
                       steps: int | None = None, engine: str = "numba", executor=None,
-                      chunk_size: int | None = None, **options) -> pd.DataFrame:
+                      chunk_size: int | None = None, progress: bool | None = None, **options) -> pd.DataFrame:
     """Decisive verdict on the rotation error p = phi - phi_d of the reduced rotation
     equation (32) on the reference ``kind`` (``"eight"`` (28) or ``"circle"`` (27)) at each
     point (R_i (m), Theta_i (rad/s)), started on the reference with p(0) = ``p0`` (rad),
@@ -158,6 +160,8 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
     come back in order (:func:`lib.parallel.map_chunks`); every point is decided on its own,
     so the frame is the one of the single-process run. Without one, ``chunk_size`` runs the
     chunks one after another here (bounding the memory of a large map).
+    ``progress``: a bar over the points on stderr (:func:`lib.parallel.show_progress`; default None: only when run
+    interactively, never under pytest or in the book build).
 
     Returns a DataFrame, one row per point, in order: R (m), Theta (rad/s), regime;
     period (reference periods of the orbit, periodic/slipping; 0 otherwise); range (rad:
@@ -193,7 +197,7 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
         raise ValueError(f"p0 and v0 must be scalars or arrays of length {N}") from e
     n_pts, n_fine = _step_counts(body, kind, R, Theta, h_lambda, steps, opts)
     parts = map_chunks(_verdict_frame, N, (R, Theta, p0, v0, n_pts, n_fine),
-                       dict(body=body, kind=kind, opts=opts, engine=engine), executor, chunk_size)
+                       dict(body=body, kind=kind, opts=opts, engine=engine), executor, chunk_size, progress)
     return concat_frames(parts)
 
 

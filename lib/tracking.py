@@ -146,7 +146,7 @@ def refined_summary(body: Body, gains: Gains, res: SimulationResult, n_periods: 
 
 def eight_sensitivity(body: Body, gains: Gains, Rs, thetas, *, n_periods: float = 12.0,
                       n_steady: float = 2.0, workers: int = 1, executor=None,
-                      chunk_size: int | None = None) -> pd.DataFrame:
+                      chunk_size: int | None = None, progress: bool | None = None) -> pd.DataFrame:
     """Steady-state measures of eight tracking (:func:`steady_summary`) over a grid of
     radii R (m) and rates theta (rad/s); one row per (R, theta). A run whose rotation
     does not settle to a periodic motion shows a large ``p_range``. The run's end state
@@ -156,7 +156,10 @@ def eight_sensitivity(body: Body, gains: Gains, Rs, thetas, *, n_periods: float 
     ``workers`` spawned processes share the runs (:func:`lib.parallel.map_in_processes`);
     or, with an ``executor`` (any :class:`concurrent.futures.Executor`, not with
     ``workers`` > 1), the runs go to it in chunks of ``chunk_size``
-    (:func:`lib.parallel.map_chunks`). Each run is on its own: the same frame either way."""
+    (:func:`lib.parallel.map_chunks`). Each run is on its own: the same frame either way.
+    ``progress``: a bar over the runs on stderr (:func:`lib.parallel.show_progress`; default None: only when run
+    interactively, never under pytest or in the book build).
+    """
     checks.instance("body", body, Body)
     checks.instance("gains", gains, Gains)
     Rs = np.atleast_1d(checks.array("Rs", Rs, positive=True))
@@ -166,10 +169,10 @@ def eight_sensitivity(body: Body, gains: Gains, Rs, thetas, *, n_periods: float 
     workers = checks.integer("workers", workers, minimum=1)
     items = [(body, gains, float(R), float(th), n_periods, n_steady) for R in Rs for th in thetas]
     if executor is None and chunk_size is None or not items:
-        return pd.DataFrame(map_in_processes(_sensitivity_one, items, workers))
+        return pd.DataFrame(map_in_processes(_sensitivity_one, items, workers, progress))
     if workers != 1:
         raise ValueError(f"give workers (> 1) or an executor/chunk_size, not both (workers = {workers!r})")
-    parts = map_chunks(_sensitivity_chunk, len(items), (items,), None, executor, chunk_size)
+    parts = map_chunks(_sensitivity_chunk, len(items), (items,), None, executor, chunk_size, progress)
     return pd.DataFrame([row for part in parts for row in part])
 
 
@@ -205,7 +208,7 @@ def saturated_intervals(t, F, cap: float, rel: float = 1e-9) -> list[tuple[float
 
 def force_cap_sweep(body: Body, gains: Gains, ref: Reference, caps, *, n_periods: int = 10,
                     n_steady: int = 2, samples_per_period: int = 400, executor=None,
-                    chunk_size: int | None = None) -> pd.DataFrame:
+                    chunk_size: int | None = None, progress: bool | None = None) -> pd.DataFrame:
     """Steady position-error amplitude (m) of tracking ``ref`` (the circle or the eight) with
     F <= cap and no angle limit, for each cap (N), from the paper's initial state.
 
@@ -216,6 +219,8 @@ def force_cap_sweep(body: Body, gains: Gains, ref: Reference, caps, *, n_periods
     ``sat_fraction`` (fraction of the samples at the cap). With an ``executor`` (any
     :class:`concurrent.futures.Executor`) the caps go to it in chunks of ``chunk_size``
     (:func:`lib.parallel.map_chunks`); each run is on its own: the same frame.
+    ``progress``: a bar over the caps on stderr (:func:`lib.parallel.show_progress`; default None: only when run
+    interactively, never under pytest or in the book build).
     """
     caps = np.atleast_1d(checks.array("caps", caps, positive=True))
     if caps.ndim != 1 or caps.size == 0:
@@ -228,7 +233,8 @@ def force_cap_sweep(body: Body, gains: Gains, ref: Reference, caps, *, n_periods
     checks.instance("body", body, Body)
     checks.instance("gains", gains, Gains)
     parts = map_chunks(_cap_chunk, caps.size, (caps,), dict(body=body, gains=gains, ref=ref, n_periods=n_periods,
-                       n_steady=n_steady, samples_per_period=samples_per_period), executor, chunk_size)
+                       n_steady=n_steady, samples_per_period=samples_per_period), executor, chunk_size,
+                       progress)
     return concat_frames(parts)
 
 

@@ -59,8 +59,8 @@ def test_map_chunks_cuts_in_order_and_passes_none_and_kwargs():
     assert map_chunks(_square, 4, (x[:4],), dict(k=1)) == [list(x[:4])]  # no executor: one call
     assert chunk_slices(5, 5) == [slice(0, 5)]
     assert concat_frames([pd.DataFrame({"a": [1]}), pd.DataFrame({"a": [2]})]).index.tolist() == [0, 1]
-    for bad in (0, -1, 1.5, True):
-        with pytest.raises(ValueError, match="chunk_size"):
+    for bad, exc in ((0, ValueError), (-1, ValueError), (1.5, TypeError), (True, TypeError)):
+        with pytest.raises(exc, match="chunk_size"):
             map_chunks(_square, 3, (x[:3],), dict(k=1), None, bad)
     with pytest.raises(TypeError, match="executor"):
         map_chunks(_square, 3, (x[:3],), dict(k=1), object(), None)
