@@ -18,9 +18,7 @@ paper). A check decides between the status the book claims for its item and
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import lru_cache
-from typing import Callable
 
 import numpy as np
 import pandas as pd
@@ -44,40 +42,12 @@ from ..tracking import steady_summary
 from ..trajectories import circle, eight, eight_heading_fourier
 from ..book_cache import cached
 from .errata import rows
+from .extensions import items as extension_items
+from .outcomes import STATUSES, Item, Outcome, decide
 
 __all__ = ["Outcome", "Item", "items", "table", "STATUSES"]
 
-STATUSES = ("reproduced", "corrected", "refuted", "not reproducible", "extended")
-
-
-@dataclass(frozen=True)
-class Outcome:
-    """Result of a report check: the status, a figure of merit with its label, a note."""
-    status: str
-    merit: float
-    merit_label: str
-    note: str = ""
-    erratum: str | None = None
-
-    def __post_init__(self) -> None:
-        if self.status not in STATUSES:
-            raise ValueError(f"unknown status {self.status!r}; known: {STATUSES}")
-        if not np.isfinite(self.merit):
-            raise ValueError(f"figure of merit must be finite, got {self.merit!r}")
-
-
-@dataclass(frozen=True)
-class Item:
-    """A row of the report: the paper's item, where the book shows it, the expected status and its check."""
-    key: str
-    paper: str
-    section: str
-    expected: str
-    check: Callable[[], Outcome]
-
-
-def _status(ok: bool, good: str, bad: str = "not reproducible") -> str:
-    return good if ok else bad
+_status = decide  # the report's short name for it
 
 
 def _erratum(key: str):
@@ -418,7 +388,7 @@ def _check_fig5() -> Outcome:
 
 
 def items() -> list[Item]:
-    """All rows of the report, in the paper's order."""
+    """All rows of the report, in the paper's order, then the book's extensions (:mod:`lib.paper.extensions`)."""
     I = Item  # noqa: E741
     return [
         I("eq2-4", "Eqs. (2)-(4): equations of motion", "chapters/01_model", "reproduced", _check_config_form),
@@ -468,7 +438,7 @@ def items() -> list[Item]:
         I("fourier", "Sec. 6: 3-term series of the eight's tangent angle", "chapters/05_stability", "corrected",
           _check_fourier),
         I("fig5", "Fig. 5: rotation-error range over (R, Theta)", "chapters/05_stability", "extended", _check_fig5),
-    ]
+    ] + extension_items()
 
 
 def table():
