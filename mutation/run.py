@@ -1,6 +1,6 @@
 """Mutation testing of the library's core modules with mutmut 3 (run by hand, not in CI).
 
-    .venv/bin/python mutation/run.py                 # the seven core modules (make mutation)
+    .venv/bin/python mutation/run.py                 # the seven core modules and the verdict procedure
     .venv/bin/python mutation/run.py angles params   # some of them
 
 mutmut mutates the modules one small change at a time (an operator, a constant, a
@@ -43,6 +43,9 @@ TESTS = {
     "control": ["tests/test_control.py", "tests/test_allocation.py"],
     "closed_loop": ["tests/test_limits.py::test_compiled_field_is_the_closed_loop_with_its_limits",
                     "tests/test_limits.py::test_switched_loop_scalar_fast_path_is_eqs_23_and_2_4"],
+    # the one decision procedure behind every verdict (issue 22): its unit tests, which feed it
+    # statistics and small maps with known answers (the flows' own tests run minutes per mutant)
+    "dynamics.verdicts": ["tests/test_verdict_procedure.py"],
 }
 #: tests written to kill survivors: always run
 ALWAYS = ["tests/test_core_mutants.py"]
@@ -69,9 +72,14 @@ markers =
 """
 
 
+def _path(module: str) -> str:
+    """The file of a module named as in :data:`TESTS` (``dynamics.verdicts``: lib/dynamics/verdicts.py)."""
+    return f"lib/{module.replace('.', '/')}.py"
+
+
 def _config(modules: list[str], tests: list[str], debug: bool = False) -> str:
     lines = ["[mutmut]", "source_paths = lib", f"debug = {str(debug).lower()}", "only_mutate ="]
-    lines += [f"    lib/{m}.py" for m in modules]
+    lines += [f"    {_path(m)}" for m in modules]
     lines += ["pytest_add_cli_args_test_selection ="] + [f"    {t}" for t in tests]
     # a fixed hypothesis seed: a mutant is killed by the same examples the clean run passed
     lines += ["pytest_add_cli_args =", "    -p", "    no:cacheprovider", "    --hypothesis-seed=0",
@@ -111,7 +119,7 @@ def _report(modules, tests, results, diffs, seconds) -> str:
     tested = len(results) - by_status.get("skipped", 0) - by_status.get("not checked", 0)
     score = 100.0 * killed / tested if tested else float("nan")
     lines = [f"## Run of {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}: "
-             f"{', '.join(f'`lib/{m}.py`' for m in modules)}", "",
+             f"{', '.join(f'`{_path(m)}`' for m in modules)}", "",
              f"- tests: {', '.join(f'`{t}`' for t in tests)}",
              f"- {len(results)} mutants: " + ", ".join(f"{n} {s}" for s, n in sorted(by_status.items())),
              f"- **score {score:.1f} %** (killed and timed out over all mutants tested)",
