@@ -28,7 +28,7 @@ def test_body_frame_form_matches_configuration_form(body, q, F, beta):
     q_minus = model.state_from_config(z - h * dz + 0.5 * h**2 * ddz, dz - h * ddz)
     fd = (q_plus - q_minus) / (2 * h)
     rhs = model.state_rhs(body, q, F, beta)
-    np.testing.assert_allclose(fd, rhs, rtol=2e-7, atol=2e-7)  # measured 2.1e-8 (1 + |rhs|) over the drawn states: O(h^2) difference
+    np.testing.assert_allclose(fd, rhs, rtol=3e-6, atol=3e-6)  # measured 2.9e-7 (1 + |rhs|) over 6000 draws: O(h^2) difference
 
 
 @functools.lru_cache(maxsize=1)

@@ -43,7 +43,7 @@ def test_eigenvalues_match_finite_difference_jacobian(theta, ratio):
         if stable:
             assert np.all(lam.real < 0)
             np.testing.assert_allclose(lam, np.sort_complex(stability.circle_eigenvalues(BODY, R, theta)),
-                                       rtol=0, atol=1e-9 * (1 + abs(lam).max()))  # measured 8.0e-11 (1 + |lam|) over 1500 draws
+                                       rtol=0, atol=2e-9 * (1 + abs(lam).max()))  # measured 2.6e-10 (1 + |lam|) over 5000 draws
         else:  # the saddle: one positive and one negative real eigenvalue
             assert lam.real.min() < 0 < lam.real.max() and np.all(abs(lam.imag) < 1e-15)  # measured 0: real eigenvalues
 
