@@ -4,6 +4,7 @@ its boundary, on inputs whose answer is known without the procedure."""
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from lib import limits, loop_verdicts, rotation_verdicts, stability
@@ -200,3 +201,107 @@ def test_undecided_rows_are_decided_again_and_keep_their_place():
     assert out.x.tolist() == [1, 20, 3, 40] and out.index.tolist() == [10, 11, 12, 13]
     assert out.horizon.tolist() == [120, 960, 120, 960]
     assert frame.regime.tolist()[1] == "undecided"            # the input is not changed
+
+
+# ---------------------------------------------------------------- the boundaries of each definition
+# (the mutation run of lib/dynamics/verdicts.py: mutation/REPORT.md). The numbers are exact in
+# binary, so each comparison is tested at its boundary, where > and >= differ.
+
+REASONS = {"zero": "Lyapunov exponent zero, but the section does not return near itself "
+                   "(no closed curve: a slow transient or a bifurcation)",
+           "unresolved": "Lyapunov exponent not resolved from zero"}
+
+
+def test_classify_at_its_boundaries():
+    band, tol = 0.75, 0.5
+    # lambda T = 3 SE = band exactly: not chaotic (strictly above), and zero within the band
+    # (|lambda T| <= band, SE = band / 3): quasi-periodic when the section returns within tol
+    regime, reason = dv.classify([0.75, 0.75, 0.9, -0.75], [0.25, 0.25, 0.5, 0.25], [0.5, 0.6, 0.0, 1.0],
+                                 band=band, return_tol=tol, max_period=4)
+    assert list(regime) == ["quasiperiodic", "undecided", "undecided", "undecided"]
+    # at -max(3 SE, band) exactly the run is not counted as contracting: it is a zero exponent
+    assert list(reason) == ["", REASONS["zero"], REASONS["unresolved"], REASONS["zero"]]
+    regime, reason = dv.classify([-0.7501], [0.25], [1.0], band=band, return_tol=tol, max_period=4)
+    assert regime[0] == "undecided" and reason[0] == "contracting, but no attracting orbit of period <= 4 reached"
+
+
+def test_heading_lost_at_three_errors_plus_the_band_exactly():
+    # a drift of exactly 3 SE + band is not lost (strictly beyond), nor on an orbit without turns
+    lost = dv.heading_lost([False, False, True], [0, 0, 0], [1.0, -1.0000001, 5.0], [0.25, 0.25, 0.0],
+                           slip_band=0.25)
+    assert lost.tolist() == [False, True, False]
+
+
+def test_drift_and_its_error_are_those_of_the_block_increments():
+    # increments 1, 2, 3, 4 per block of 2 periods, in units of 2: mean 2.5 / 4, and the
+    # standard error std(ddof = 1) / sqrt(4) = 1.2910 / 2 / 4; a second row standing still
+    ends = np.array([[0.0, 1.0, 3.0, 6.0, 10.0], [7.0] * 5])
+    drift, se = dv.drift_statistics(ends, periods_per_block=2.0, unit=2.0)
+    np.testing.assert_allclose(drift, [2.5 / 4, 0.0], rtol=1e-15, atol=0)  # measured 0
+    np.testing.assert_allclose(se, [np.std([1, 2, 3, 4], ddof=1) / 2 / 4, 0.0], rtol=1e-15, atol=0)  # measured 0
+
+
+def test_block_statistics_need_two_blocks_and_take_the_last_complete_ones():
+    # 5 periods in blocks of 2: the last 4 form 2 blocks (means 2.5 and 4.5), the first is dropped
+    mean, se = dv.block_statistics(np.array([[100.0, 2.0, 3.0, 4.0, 5.0]]), 2)
+    assert mean[0] == 3.5 and se[0] == pytest.approx(np.std([2.5, 4.5], ddof=1) / np.sqrt(2), rel=1e-15)  # measured 0
+    with pytest.raises(ValueError, match="two blocks"):
+        dv.block_statistics(np.ones((1, 3)), 2)
+
+
+def test_held_is_periodic_not_lost_and_tracked():
+    regime = ["periodic", "periodic", "periodic", "slipping", "chaotic"]
+    assert dv.held(regime, [False, True, False, False, False], [True, True, False, True, True]).tolist() == \
+        [True, False, False, False, False]
+    assert dv.held(regime, [False] * 5).tolist() == [True, True, True, False, False]  # no position: tracked
+
+
+def test_a_single_undecided_row_is_decided_again():
+    frame = pd.DataFrame({"regime": ["periodic", "undecided"], "x": [1.0, 2.0]}, index=[10, 11])
+    seen = []
+
+    def redo(rows, factor):
+        seen.append((rows.tolist(), factor))
+        return pd.DataFrame({"regime": ["chaotic"], "x": [-2.0]})
+
+    out = dv.redecide_undecided(frame, 120, 8, redo)
+    assert seen == [([1], 8)]
+    assert out.regime.tolist() == ["periodic", "chaotic"] and out.x.tolist() == [1.0, -2.0]
+    assert out.horizon.tolist() == [120, 960] and frame.regime.tolist() == ["periodic", "undecided"]
+
+
+def test_section_returns_tell_a_closed_curve_from_a_slow_approach():
+    L = 400
+    k = np.arange(L)[:, None]
+    rot = 2 * np.pi * (np.sqrt(5) - 1) / 2                           # an irrational rotation
+    circle = np.stack([np.cos(k * rot), np.sin(k * rot)], axis=2)     # (L, 1, 2), fills a circle
+    line = np.stack([0.97 ** k, 0.5 * 0.97 ** k], axis=2)             # slides along a line onto 0
+    # the heading column wraps: a circle drawn across +-pi is still closed
+    wrapped = np.stack([np.pi + 0.3 * np.cos(k * rot), 0.3 * np.sin(k * rot)], axis=2)
+    r = dv.section_returns(np.concatenate([circle, line, wrapped], axis=1), angles=(0,))
+    assert r[0] < 0.05 and r[2] < 0.05    # measured 5.7e-3 (both); 0.05 is the flows' return_tol
+    assert r[1] == np.inf                 # reason: never comes back after leaving, by construction
+    assert dv.section_returns(circle[:5]).tolist() == [np.inf]
+    with pytest.raises(ValueError, match="shape"):
+        dv.section_returns(np.zeros((10, 2)))
+
+
+def test_enclosed_orbit_finds_an_attracting_or_repelling_fixed_point_inside_a_curve():
+    # x -> c + A (x - c): a fixed point at c (heading column 0 at pi, reached across the
+    # wrap) that attracts for A = 0.5 R and repels for A = 1.5 R, R a rotation
+    c = np.array([np.pi, 0.2])
+    rot = np.array([[np.cos(1.0), -np.sin(1.0)], [np.sin(1.0), np.cos(1.0)]])
+    gains = np.array([0.5, 1.5])
+
+    def step(idx, x, k):
+        A = gains[np.asarray(idx)][:, None, None] * rot
+        return c + np.einsum("mij,mj->mi", A, x - c), A
+
+    t = np.linspace(0, 2 * np.pi, 40, endpoint=False)[:, None]
+    curve = c + 0.3 * np.stack([np.cos(t), np.sin(t)], axis=2)       # (40, 1, 2) around c
+    sec = np.concatenate([curve, curve], axis=1)
+    sec[:, :, 0] = (sec[:, :, 0] + np.pi) % (2 * np.pi) - np.pi     # headings wrapped to (-pi, pi]
+    attracting, mu = dv.enclosed_orbit(step, np.array([0, 1]), sec, turn_axis=0, newton_tol=1e-12,
+                                       newton_options=dict(max_iter=10))
+    assert attracting.tolist() == [True, False]
+    np.testing.assert_allclose(mu, gains, rtol=1e-13)  # measured 0
