@@ -151,7 +151,11 @@ def main() -> int:
         # a subprocess sees): mutmut runs the tests in mutants/ under the work directory
         # (made now: a directory missing when the interpreter starts is never searched later)
         (work / "mutants").mkdir()
-        env = dict(os.environ, PYTHONPATH=str(work / "mutants"), PYTHONHASHSEED="0")
+        # mutmut forks a child per mutant after running the tests in the parent: numba's OpenMP
+        # threading layer aborts a forked child (the mutant then reads "suspicious"), its
+        # workqueue layer does not
+        env = dict(os.environ, PYTHONPATH=str(work / "mutants"), PYTHONHASHSEED="0",
+                   NUMBA_THREADING_LAYER="workqueue")
         code = subprocess.run(["nice", "-n", "19", str(VENV_BIN / "mutmut"), "run", "--max-children", "2"],
                               cwd=work, env=env).returncode
         seconds = time.time() - t0
