@@ -112,7 +112,7 @@ def _checked_body(body) -> Body:
 
 def least_squares_problem(tau, phi, body: Body, weights):
     """The weighted least-squares problem of :func:`allocate_least_squares`, validated;
-    see :func:`_ls_kernel`."""
+    see ``_ls_kernel``."""
     tau = _check_tau(tau)
     w = _check_weights(weights)
     return _ls_kernel(tau, checks.array("phi", phi), _checked_body(body), np.sqrt(w))

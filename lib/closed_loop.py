@@ -50,6 +50,35 @@ class ClosedLoop:
     @classmethod
     def of(cls, body: Body, gains: Gains, kinematics: Kinematics, allocation: Allocation | None = None,
            limits: Limits | None = None, model: Body | None = None) -> "ClosedLoop":
+        """The closed loop of a plant, its gains and a reference, validated once.
+
+        Parameters
+        ----------
+        body : Body
+            The plant, integrated by (2)-(4).
+        gains : Gains
+            The gains Kp, Kv of (23).
+        kinematics : callable
+            t (s) -> (z_d, dz_d, ddz_d), each (..., 3) in m, m/s, m/s^2 (and rad for the
+            heading): :func:`reference_of` a reference of :mod:`lib.trajectories`.
+        allocation : Allocation, optional
+            The allocation law (default the paper's (25)-(26)).
+        limits : Limits, optional
+            Force and angle limits (default none).
+        model : Body, optional
+            The controller's model of the body, used by (23) and the allocation
+            (default None: the plant's own).
+
+        Returns
+        -------
+        ClosedLoop
+            The loop, whose :meth:`rates` checks nothing.
+
+        Raises
+        ------
+        TypeError
+            If a part is of the wrong type, naming it.
+        """
         checks.instance("gains", gains, Gains)
         allocation = checks.instance("allocation", Allocation() if allocation is None else allocation, Allocation)
         if model is not None:

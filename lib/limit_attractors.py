@@ -36,7 +36,7 @@ __all__ = ["MIRROR", "mirror_state", "half_period_mirror", "mirror_defect", "mir
            "heading_offset_starts", "start_attractors", "lyapunov_horizons", "lyapunov_separations",
            "SAME_ORBIT_TOL"]
 
-#: sigma on a state [x, y, phi, xdot, ydot, phidot]: (x, -y, -phi) and their rates
+#: The mirror sigma on a state [x, y, phi, xdot, ydot, phidot], as signs, (x, -y, -phi) and their rates.
 MIRROR = np.array([1.0, -1.0, -1.0, 1.0, -1.0, -1.0])
 
 #: two located orbits are the same when every point of one lies this close (max-norm, the

@@ -3,7 +3,7 @@ allocation (weights (w_x, w_y, w_phi); w_phi = 0 is exactly the paper's law (25)
 classified by the book's one decision procedure (:mod:`lib.dynamics.verdicts`), as
 Chapter 5 classifies the reduced rotation (32). Chapter 6 uses it for both laws.
 
-This module supplies the period map (:class:`_PeriodFlow`: all points in lockstep by
+This module supplies the period map (``_PeriodFlow``: all points in lockstep by
 the batch RK4 in the normalised time tau = t / T) and what the closed loop reports
 beyond the verdict: the position's drift and whether it is held.
 
@@ -72,7 +72,7 @@ LOOP_VERDICT_DEFAULTS = MappingProxyType(dict(
 
 
 def _lean(allocation, limits, w) -> bool:
-    """Whether :class:`_PeriodFlow` runs its lean field: the least-squares law without limits
+    """Whether ``_PeriodFlow`` runs its lean field: the least-squares law without limits
     and w_x w_y > 0 at every point of the call."""
     return allocation == "least_squares" and limits.force is None and limits.angle is None \
         and bool(np.all(w[:, 0] * w[:, 1] > 0))

@@ -63,8 +63,11 @@ def config_accel(body: Body, z, dz, F, beta) -> np.ndarray:
 def f(body: Body, q) -> np.ndarray:
     """Drift vector field of eq. (5), derived from (2)-(4) (the corrected eq. (6)).
 
-    f(q) = [v1 cos(phi) - v2 sin(phi), v1 sin(phi) + v2 cos(phi), omega,
-            -c/m v1 + v2 omega, -c/m v2 - v1 omega, -c_phi/I_C omega].
+    ::
+
+        f(q) = [v1 cos(phi) - v2 sin(phi), v1 sin(phi) + v2 cos(phi), omega,
+                -c/m v1 + v2 omega, -c/m v2 - v1 omega, -c_phi/I_C omega].
+
     The fifth row differs in sign from the printed (6): see :func:`f_printed`.
     """
     q = _last_axis(q, 6, "q")

@@ -17,9 +17,9 @@ from . import checks
 
 __all__ = ["Body", "Gains", "PAPER_Z0", "PAPER_DZ0"]
 
-#: Initial configuration of the paper's Table: x = 1 m, y = 0 m, phi = pi/2 rad.
+#: The initial configuration of the paper's Table (x = 1 m, y = 0 m, phi = pi/2 rad).
 PAPER_Z0 = (1.0, 0.0, math.pi / 2)
-#: Initial velocities of the paper's Table: the body starts at rest.
+#: The initial velocities of the paper's Table (the body starts at rest).
 PAPER_DZ0 = (0.0, 0.0, 0.0)
 
 
@@ -27,13 +27,25 @@ PAPER_DZ0 = (0.0, 0.0, 0.0)
 class Body:
     """The planar rigid body of eqs. (2)-(4), defaults from the paper's Table.
 
-    Attributes
+    Parameters
     ----------
-    m : mass (kg).
-    I : moment of inertia about the centre of mass C, I_C (kg m^2).
-    a : distance from C to the point where the force acts (m).
-    c : linear viscous drag coefficient (N s / m).
-    c_phi : rotational viscous drag coefficient (N m s).
+    m : float
+        Mass (kg), > 0.
+    I : float
+        Moment of inertia about the centre of mass C, I_C (kg m^2), > 0.
+    a : float
+        Distance from C to the point where the force acts (m), > 0.
+    c : float
+        Linear viscous drag coefficient (N s / m), > 0.
+    c_phi : float
+        Rotational viscous drag coefficient (N m s), > 0.
+
+    Raises
+    ------
+    TypeError
+        If a value is not a real number (a str, a bool).
+    ValueError
+        If a value is not positive and finite.
     """
 
     m: float = 2.0
@@ -49,12 +61,12 @@ class Body:
 
     @property
     def mass_matrix(self) -> np.ndarray:
-        """M of eq. (22): diag(m, m, I_C)."""
+        """The mass matrix M = diag(m, m, I_C) of eq. (22) (kg, kg, kg m^2)."""
         return np.diag([self.m, self.m, self.I])
 
     @property
     def drag(self) -> np.ndarray:
-        """Drag coefficients (c, c, c_phi), so that N(dz) = drag * dz in eq. (22)."""
+        """The drag coefficients (c, c, c_phi), so that N(dz) = drag * dz in eq. (22)."""
         return np.array([self.c, self.c, self.c_phi])
 
 

@@ -133,7 +133,7 @@ def plot_section(section, i: int = 0, j: int = 4, *, ax=None, color: str = "k", 
     return fig
 
 
-#: how each non-periodic regime of :func:`lib.rotation.rotation_verdicts` is drawn on the maps
+#: how each non-periodic regime of :func:`lib.rotation_verdicts.rotation_verdicts` is drawn on the maps
 REGIME_COLORS = {"slipping": "C3", "chaotic": "0.15", "quasiperiodic": "C0", "undecided": "0.7"}
 
 
@@ -153,7 +153,7 @@ def _cells(R: np.ndarray, Th: np.ndarray):
 
 def plot_fig5(frame: pd.DataFrame, ax=None):
     """Fig. 5: range (rad) of the rotation error over the attracting orbit at the periodic
-    points of a rectangular (R, Theta) grid (:func:`lib.rotation.rotation_verdicts`), the
+    points of a rectangular (R, Theta) grid (:func:`lib.rotation_verdicts.rotation_verdicts`), the
     other regimes in flat colours (:data:`REGIME_COLORS`), and the points where stability
     is lost (column ``lost``) ringed, as the paper's empty circles. Returns the figure."""
     fig, ax = new_axes(ax, figsize=(7, 5))
@@ -201,7 +201,7 @@ def plot_fig5_exponents(frame: pd.DataFrame):
 
 def plot_circle_map(frame: pd.DataFrame, body: Body, coexists=None, ax=None):
     """Where the circle's rotation error settles or slips (``frame`` from
-    :func:`circle_final_state`), with the analytic boundary R_crit(theta) of (36)
+    :func:`lib.circle_rotation.circle_final_state`), with the analytic boundary R_crit(theta) of (36)
     and, if given, the points where slipping coexists with the stable equilibrium."""
     if ax is None:
         fig, ax = plt.subplots(figsize=(7, 5))
@@ -222,7 +222,7 @@ def plot_circle_map(frame: pd.DataFrame, body: Body, coexists=None, ax=None):
 
 def plot_heading_orbits(orbits: dict, t, p, distances: dict, multiplier: float):
     """The eight's heading error against its attracting orbits: (a) each orbit's p over
-    one period (``orbits``: label -> :class:`lib.rotation.RotationAttractor`) with the
+    one period (``orbits``: label -> :class:`lib.rotation_attractor.RotationAttractor`) with the
     run's last period (t (s), p (rad)) on top; (b) the run's distance to each orbit per
     period (``distances``: label -> array, from ``distance_per_period``) on a log scale,
     with the rate |mu_1|^j of the slowest Floquet multiplier ``multiplier``. Returns the figure."""
@@ -306,7 +306,7 @@ def plot_bistable_window(theta, r_crit, r_edge, grid: pd.DataFrame, grid_r_crit,
     """The circle's bistable window over the rate: R_edge/R_crit - 1 (log scale) against
     theta (rad/s), from ``theta``, ``r_crit``, ``r_edge`` (arrays, m) of
     :func:`lib.circle_rotation.bistable_window`; over it the grid points of
-    :func:`circle_final_state` (``grid``, with R_crit per point ``grid_r_crit``) where a
+    :func:`lib.circle_rotation.circle_final_state` (``grid``, with R_crit per point ``grid_r_crit``) where a
     slipping motion coexists (``coexists``, by simulation) or not; a dashed line at
     ``theta_close`` and, if given, ``mark`` = (theta, R_edge/R_crit - 1) as a star."""
     if ax is None:

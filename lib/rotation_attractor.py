@@ -78,7 +78,7 @@ def rotation_attractor(body: Body, kind: str, R: float, Theta: float, *, p0: flo
                        h_lambda: float = 0.125, steps: int | None = None, **options) -> RotationAttractor:
     """The attracting periodic orbit of the heading error p = phi - phi_d of (32) on the
     reference ``kind`` at one point (R (m), Theta (rad/s)) that the run from p(0) = ``p0``
-    (rad), dp/dt(0) = ``v0`` (rad/s) reaches, as decided by :func:`rotation_verdicts`
+    (rad), dp/dt(0) = ``v0`` (rad/s) reaches, as decided by :func:`lib.rotation_verdicts.rotation_verdicts`
     (same options). On the eight (28) the rotation equation (37) is symmetric and has two
     mirror-image period-1 orbits; which one a start reaches is reported by
     ``states[0, 0]``. Raises ValueError if the run reaches no attracting orbit (the
@@ -123,7 +123,7 @@ def rotation_attractor(body: Body, kind: str, R: float, Theta: float, *, p0: flo
 
 @dataclass(frozen=True)
 class MapSummary:
-    """What a map of verdicts (:func:`rotation_verdicts`) shows, for the book to quote.
+    """What a map of verdicts (:func:`lib.rotation_verdicts.rotation_verdicts`) shows, for the book to quote.
 
     Counts: ``n_grid`` points; ``n_periodic``, ``n_slipping``, ``n_chaotic``,
     ``n_quasiperiodic``, ``n_undecided`` per regime; ``n_lost`` where the heading is lost
@@ -174,8 +174,8 @@ class MapSummary:
 
 
 def map_summary(frame: pd.DataFrame) -> MapSummary:
-    """The :class:`MapSummary` of a frame returned by :func:`rotation_verdicts` (or
-    :func:`eight_rotation_sweep`)."""
+    """The :class:`MapSummary` of a frame returned by :func:`lib.rotation_verdicts.rotation_verdicts` (or
+    :func:`lib.rotation_verdicts.eight_rotation_sweep`)."""
     need = {"regime", "period", "range", "floquet", "lyapunov", "lyapunov_stderr", "lost", "turns_round", "Theta",
             "periods"}
     if not isinstance(frame, pd.DataFrame) or not need <= set(frame.columns):

@@ -21,12 +21,12 @@ __all__ = ["verdict_steps", "RotationMap", "orbit_range"]
 
 
 def verdict_steps(body: Body, kind: str, R, Theta, h_lambda: float = 0.125, h_damp: float = 1.0) -> np.ndarray:
-    """Fixed steps per reference period for :func:`rotation_verdicts`: the smallest
+    """Fixed steps per reference period for :func:`lib.rotation_verdicts.rotation_verdicts`: the smallest
     multiple of 32 (>= 64) with h omega <= ``h_lambda`` and h A <= ``h_damp``, where
     omega = sqrt(B v_max + C a_max) bounds the frequencies of the linearised equation
     (32) (in the phase s) and A is its damping. The damping only sets how fast a
     transient in w dies out, which the 8th-order scheme follows well beyond h A = 1,
-    so this asks for about half the steps of :func:`steps_per_period` at the same
+    so this asks for about half the steps of :func:`lib.rotation.steps_per_period` at the same
     accuracy of the attractor (about 1e-10 rad per period)."""
     at, _ = _shape(kind)
     s = np.linspace(0, 2 * np.pi, 721)
@@ -138,9 +138,12 @@ class RotationMap:
         return np.column_stack([o["phi"] - self.eng.w2pi * k, o["w"]]), o
 
     def advance(self, idx, x, k):
+        """The states of rows ``idx`` k periods after x (N, 2)."""
         return self._run(idx, x, k, False)[0]
 
     def step(self, idx, x, k):
+        """The states of rows ``idx`` k periods after x (N, 2), and the exact Jacobian of the
+        discrete map (N, 2, 2)."""
         y, o = self._run(idx, x, k, True)
         return y, o["J"]
 

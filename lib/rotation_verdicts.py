@@ -47,7 +47,7 @@ def eight_rotation_sweep(body: Body, R, Theta, **options) -> pd.DataFrame:
     return rotation_verdicts(body, "eight", R, Theta, **options)
 
 
-#: the book's Fig. 5 grid: n x n points, R evenly in ``R`` (m), Theta evenly in ``Theta`` (rad/s)
+#: The book's Fig. 5 grid of n x n points, R evenly in ``R`` (m) and Theta evenly in ``Theta`` (rad/s).
 FIG5_GRID = MappingProxyType(dict(R=(0.25, 4.0), Theta=(0.05, 1.5), n=100))
 
 
@@ -83,7 +83,7 @@ _DEFAULTS = dict(transient=48, min_transient=8, chunk=8, max_period=8, lyapunov_
 #: the default options of :func:`rotation_verdicts` (read-only), for the book to quote
 VERDICT_DEFAULTS = MappingProxyType(_DEFAULTS)
 
-#: a Floquet modulus above this counts as a slowly attracting orbit in :class:`MapSummary`
+#: a Floquet modulus above this counts as a slowly attracting orbit in :class:`lib.rotation_attractor.MapSummary`
 SLOW_FLOQUET = 0.9
 
 
@@ -167,7 +167,7 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
     period (reference periods of the orbit, periodic/slipping; 0 otherwise); range (rad:
     max - min of p over the attracting orbit at every step (a slipping one over the k
     periods from its point at s = 0, where p runs on by 2 pi n), extremes refined by cubic
-    Hermite interpolation (:func:`sampled_range`); over the Lyapunov run otherwise);
+    Hermite interpolation (:func:`lib.rotation.sampled_range`); over the Lyapunov run otherwise);
     floquet (largest multiplier modulus); lyapunov, lyapunov_stderr (1/s; for an orbit
     ln|mu_1| / (k T) with no error); slip, slip_stderr (turns of p per period: n / k on
     an orbit, the measured drift over the Lyapunov run with its batch-means error

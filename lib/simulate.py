@@ -168,6 +168,7 @@ def _simulate_events(body, gains, ref, t_end, z0, dz0, limits: Limits, t_eval,
                             tau=tau, ref=ref, mode=seg.mode)
 
 
+#: The model forms :func:`simulate_open_loop` integrates (``form``).
 OPEN_LOOP_FORMS = ("config", "state", "printed")
 
 
@@ -222,7 +223,7 @@ def _demo_angle(t):
     return 0.8 * np.sin(0.7 * t)
 
 
-#: initial state of the open-loop comparison: moving forward and turning
+#: The initial state [x, y, phi, v1, v2, omega] of the open-loop comparison (moving forward and turning).
 DEMO_Q0 = (0.0, 0.0, 0.0, 0.5, 0.0, 0.2)
 
 

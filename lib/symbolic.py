@@ -138,7 +138,7 @@ def printed_drift(model: SymbolicModel | None = None) -> sp.Matrix:
 # ---------------------------------------------------------------- Lie brackets (Sec. 3)
 
 Bracket = Union[str, tuple]
-"""A bracket expression: a field name (``"f"``, ``"g1"``) or a pair ``(X, Y)``
+"""A bracket expression, a field name (``"f"``, ``"g1"``) or a pair ``(X, Y)``
 standing for [X, Y]; e.g. ``("g1", ("f", "g2"))`` is [g1, [f, g2]]."""
 
 

@@ -82,7 +82,7 @@ class CircleSteadyState:
 
     @property
     def max_real(self) -> float:
-        """Largest real part of the eigenvalues (1/s): negative iff locally asymptotically stable."""
+        """The largest real part of the eigenvalues (1/s), negative iff locally asymptotically stable."""
         return float(self.eigenvalues[0].real)
 
     @property

@@ -206,17 +206,17 @@ class MapComparison:
 
     @property
     def lost(self) -> np.ndarray:
-        """(N,) bool: the heading is lost (it slips) under the paper's law."""
+        """Whether the heading is lost (it slips) under the paper's law, per point (N,)."""
         return self.paper.lost.to_numpy()
 
     @property
     def paper_held(self) -> np.ndarray:
-        """(N,) bool: the paper's law holds the loop (:func:`held`)."""
+        """Whether the paper's law holds the loop (:func:`held`), per point (N,)."""
         return held(self.paper)
 
     @property
     def held(self) -> np.ndarray:
-        """(N,) bool: the weighted law holds the loop (:func:`held`)."""
+        """Whether the weighted law holds the loop (:func:`held`), per point (N,)."""
         return held(self.weighted)
 
     @property
@@ -240,9 +240,9 @@ class MapComparison:
 
     @property
     def cross(self) -> pd.DataFrame:
-        """Points by the paper's law (rows: held / not held) against the weighted law (columns:
-        held, or the first reason it is not: position not tracked, heading lost, not periodic),
-        with totals; the "held" row and column total the counts' "held"."""
+        """The points by the paper's law (rows, held or not held) against the weighted law
+        (columns, held or the first reason it is not, one of position not tracked, heading
+        lost, not periodic), with totals; the "held" row and column total the counts' "held"."""
         pl = pd.Series(np.where(self.paper_held, "held", "not held"), name="paper's law")
         wl = pd.Series(self._why(self.weighted), name="weighted law")
         x = pd.crosstab(pl, wl, margins=True, margins_name="total")

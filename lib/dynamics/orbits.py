@@ -12,7 +12,7 @@ DP^k at the orbit are its Floquet multipliers: the orbit attracts when all lie
 inside the unit circle.
 
 :func:`newton_orbit` works on any map given with its Jacobian, vectorised over
-points; :func:`rotation_period_map` is the period map of the reduced rotation
+points; :func:`lib.rotation.rotation_period_map` is the period map of the reduced rotation
 equation (32) on the eight (28) or the circle (27), integrated with the same
 fixed-step 8th-order Dormand-Prince scheme as the Fig. 5 sweep
 (:func:`lib.stability.rotation_sweep`), its Jacobian by integrating the
@@ -58,7 +58,7 @@ class Orbit:
 
     @property
     def attracting(self) -> np.ndarray:
-        """(N,) bool: converged and every multiplier inside the unit circle."""
+        """Converged and every multiplier inside the unit circle, one bool per row (N,)."""
         return self.converged & (np.abs(self.multipliers[:, 0]) < 1.0)
 
 
@@ -90,7 +90,7 @@ def newton(step: Callable, idx, x0, k, *, turn_axis: int = 0, turns=None, tol: f
     """Orbits of period k: Newton on G(x) = P^k(x) - x - 2 pi n e_turn for many rows.
 
     ``step(idx, x, k) -> (P^k(x), DP^k)`` for the rows ``idx`` (the map's exact
-    Jacobian, or :func:`difference_jacobian`). ``turns``: the whole turns n per row
+    Jacobian, or :func:`lib.dynamics.verdicts.difference_jacobian`). ``turns``: the whole turns n per row
     (M,), or None to take n afresh at every iterate as the turns P^k(x) - x is nearest
     to. Steps longer than ``max_step`` (max-norm) are cut back to it. A row goes on
     while its residual exceeds ``tol`` (after ``stall_after`` iterations, only while

@@ -222,7 +222,7 @@ class SwitchedLoop:
         non-smooth point is located as an event and the integrator restarted
         there, so that no step straddles one: the switching surface (a jump of
         the field), the exits from sliding, and the kinks of the smooth fields
-        (:meth:`_kink_functions`). A step across a kink would cost the
+        (``_kink_functions``). A step across a kink would cost the
         high-order method its order without its error estimate noticing, and
         the global error would stop following the tolerance. An event just
         crossed is watched only in the opposite direction on restart, so that

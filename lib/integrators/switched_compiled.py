@@ -12,7 +12,7 @@ modes (+1 / -1 smooth on a side, 0 sliding), by a different scheme:
   discrete period map is exactly T-periodic, as the flow's is;
 - at the end of each step the event functions are evaluated: the switching
   function mode * lat + eps_lat (watched falling through zero), the sliding
-  exits r_+ + k lat (rising) and r_- + k lat (falling), and the kinks
+  exits ``r_+ + k lat`` (rising) and ``r_- + k lat`` (falling), and the kinks
   |tau| sin(psi -+ beta_max) and |tau|^2 - F_max^2 (either way). If one changed
   sign, the step is redone from its start with a shorter step: its root is
   first estimated on the step's cubic Hermite interpolant and bracketed by two
