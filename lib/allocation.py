@@ -37,7 +37,23 @@ def _check_limit(name: str, value, upper: float | None) -> float:
 class Limits:
     """Force and angle limits of the paper's Sec. 5: F <= ``force`` (N, eq. (29)) and
     |beta| <= ``angle`` (rad, in (0, pi], eq. (30)); None means no limit. Validated
-    on construction."""
+    on construction.
+
+    Parameters
+    ----------
+    force : float, optional
+        F_max (N), > 0; None for no cap.
+    angle : float, optional
+        beta_max (rad), in (0, pi]; None for no limit.
+
+    Raises
+    ------
+    TypeError
+        If a limit is not a real number (a str, a bool, an array), naming it
+        (``force_limit``, ``angle_limit``).
+    ValueError
+        If a limit is not positive and finite, or the angle exceeds pi.
+    """
 
     force: float | None = None
     angle: float | None = None
@@ -77,7 +93,32 @@ def allocate(tau, phi, force_limit: float | None = None, angle_limit: float | No
     When tau_x = tau_y = 0 no force is needed: F = 0 and beta = 0 by
     definition (the direction of a zero force is immaterial).
 
-    Returns (F, beta) as arrays of the broadcast shape of tau[..., 0] and phi.
+    Parameters
+    ----------
+    tau : array_like
+        Demanded generalized force [tau_x (N), tau_y (N), (tau_phi (N m))], shape (..., 2)
+        or (..., 3).
+    phi : array_like
+        Heading (rad), broadcast against ``tau[..., 0]``.
+    force_limit : float, optional
+        F_max (N), > 0: F is capped at it (eq. (29)); None for no cap.
+    angle_limit : float, optional
+        beta_max (rad), in (0, pi]: beta is clipped to [-beta_max, beta_max] (eq. (30));
+        None for no limit.
+
+    Returns
+    -------
+    F : numpy.ndarray
+        Force magnitude (N), >= 0, of the broadcast shape of ``tau[..., 0]`` and ``phi``.
+    beta : numpy.ndarray
+        Force angle to the body axis (rad), in (-pi, pi]; 0 where F = 0.
+
+    Raises
+    ------
+    TypeError
+        If an argument is of the wrong type (a str, a bool), naming it.
+    ValueError
+        If an argument is out of range or not finite (an array's first bad index named).
     """
     return _position(_check_tau(tau, (2, 3)), checks.array("phi", phi), Limits(force_limit, angle_limit))
 
@@ -179,7 +220,37 @@ def allocate_limited(tau, phi, body: Body, weights=(1.0, 1.0, 0.0),
     an interior minimum of a convex function is unconstrained.
 
     With no limit it is :func:`allocate_least_squares`; with w_phi = 0 and no limit,
-    exactly (25)-(26). Returns (F (N), beta (rad)) like :func:`allocate`.
+    exactly (25)-(26).
+
+    Parameters
+    ----------
+    tau : array_like
+        Demanded generalized force [tau_x (N), tau_y (N), tau_phi (N m)], shape (..., 3).
+    phi : array_like
+        Heading (rad), broadcast against ``tau[..., 0]``.
+    body : Body
+        The body (its lever arm a (m) enters B(phi)).
+    weights : array_like
+        (w_x, w_y, w_phi) >= 0, not all zero, shape (3,) or (..., 3).
+    force_limit : float, optional
+        F_max (N), > 0: F is capped at it (eq. (29)); None for no cap.
+    angle_limit : float, optional
+        beta_max (rad), in (0, pi]: beta is clipped to [-beta_max, beta_max] (eq. (30));
+        None for no limit.
+
+    Returns
+    -------
+    F : numpy.ndarray
+        Force magnitude (N), >= 0, of the broadcast shape of ``tau[..., 0]`` and ``phi``.
+    beta : numpy.ndarray
+        Force angle to the body axis (rad), in (-pi, pi]; 0 where F = 0.
+
+    Raises
+    ------
+    TypeError
+        If an argument is of the wrong type (a str, a bool), naming it.
+    ValueError
+        If an argument is out of range or not finite (an array's first bad index named).
     """
     limits = Limits(force_limit, angle_limit)
     return _limited(_check_tau(tau), checks.array("phi", phi), _checked_body(body), np.sqrt(_check_weights(weights)), limits)
@@ -277,7 +348,35 @@ def allocate_least_squares(tau, phi, body: Body, weights=(1.0, 1.0, 0.0),
     applied as in :func:`allocate` (cap on F, clip of beta): a projection of the
     unconstrained optimum, not the optimum under the limits.
 
-    Returns (F (N), beta (rad)), beta in (-pi, pi]; F = 0, beta = 0 when u* = 0.
+    Parameters
+    ----------
+    tau : array_like
+        Demanded generalized force [tau_x (N), tau_y (N), tau_phi (N m)], shape (..., 3).
+    phi : array_like
+        Heading (rad), broadcast against ``tau[..., 0]``.
+    body : Body
+        The body (its lever arm a (m) enters B(phi)).
+    weights : array_like
+        (w_x, w_y, w_phi) >= 0, not all zero, shape (3,) or (..., 3).
+    force_limit : float, optional
+        F_max (N), > 0: F is capped at it (eq. (29)); None for no cap.
+    angle_limit : float, optional
+        beta_max (rad), in (0, pi]: beta is clipped to [-beta_max, beta_max] (eq. (30));
+        None for no limit.
+
+    Returns
+    -------
+    F : numpy.ndarray
+        Force magnitude (N), >= 0, of the broadcast shape of ``tau[..., 0]`` and ``phi``.
+    beta : numpy.ndarray
+        Force angle to the body axis (rad), in (-pi, pi]; 0 where F = 0.
+
+    Raises
+    ------
+    TypeError
+        If an argument is of the wrong type (a str, a bool), naming it.
+    ValueError
+        If an argument is out of range or not finite (an array's first bad index named).
     """
     limits = Limits(force_limit, angle_limit)
     return _weighted(_check_tau(tau), checks.array("phi", phi), _checked_body(body), np.sqrt(_check_weights(weights)), limits)

@@ -27,9 +27,33 @@ def computed_torque(body: Body, gains: Gains, ref, t, z, dz) -> np.ndarray:
     """Computed-torque demand, eq. (23).
 
     tau = M ddz_d + N(dz) + Kv (dz_d - dz) + Kp (z_d - z), with N(dz) = (c xdot, c ydot, c_phi phidot).
-    ``ref`` is a reference (:mod:`lib.trajectories`), ``t`` time(s) in s, ``z`` and
-    ``dz`` the actual configuration and its rate, shape (..., 3).
-    Returns tau = [tau_x (N), tau_y (N), tau_phi (N m)], shape (..., 3).
+
+    Parameters
+    ----------
+    body : Body
+        The controller's model of the body (m, I_C and the drag).
+    gains : Gains
+        The gains Kp, Kv.
+    ref : Reference
+        The reference (:mod:`lib.trajectories`).
+    t : float or array_like
+        Time(s) (s), broadcast against the leading axes of ``z``.
+    z : array_like
+        Actual configuration (x (m), y (m), phi (rad)), shape (..., 3).
+    dz : array_like
+        Its rate (m/s, m/s, rad/s), shape (..., 3).
+
+    Returns
+    -------
+    numpy.ndarray
+        tau = [tau_x (N), tau_y (N), tau_phi (N m)], shape (..., 3).
+
+    Raises
+    ------
+    TypeError
+        If an argument is of the wrong type, naming it.
+    ValueError
+        If an array has the wrong shape or a non-finite entry (its index named).
     """
     checks.instance("body", body, Body)
     checks.instance("gains", gains, Gains)

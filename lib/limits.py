@@ -139,6 +139,38 @@ def sweep_angle_limit(body: Body, gains: Gains, ref: Reference, angle_limits, *,
     points recorded (their period found by :func:`section_period` with ``tol``),
     and the largest Lyapunov exponent estimated over ``n_lyap`` periods starting
     from the end of the section.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    ref : Circle or Eight
+        The reference.
+    angle_limits : float or array_like
+        beta_max (rad), in (0, pi].
+    force_limit : float, optional
+        F_max (N), > 0; None for no cap.
+    n_transient, n_points, n_lyap : int
+        Periods dropped (>= 0), section points (>= 1), Lyapunov periods (>= 1).
+    tol : float
+        Section period tolerance (the error state's units), > 0.
+    rtol, atol : float
+        Tolerances of the adaptive integrator, > 0.
+    d0 : float
+        Initial separation of the Lyapunov companion, > 0.
+    z0, dz0 : array_like, optional
+        Start (m, m, rad; m/s, m/s, rad/s), default the paper's Table.
+    workers : int
+        Spawned processes (>= 1).
+    progress : bool, optional
+        A progress bar over the limits (default None: only when run interactively).
+
+    Returns
+    -------
+    list of Regime
+        One per angle limit, in order.
     """
     angles = _check_sweep(body, gains, ref, angle_limits, force_limit, n_transient=n_transient,
                           n_points=n_points, n_lyap=n_lyap, tol=tol, rtol=rtol, atol=atol, d0=d0)
@@ -246,7 +278,39 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
     ``progress``: a bar over the pairs on stderr (:func:`lib.parallel.show_progress`; default None: only when run
     interactively, never under pytest or in the book build).
 
-    Returns (a DataFrame with one row per pair, the :class:`SwitchedRuns`)."""
+    Parameters
+    ----------
+    body : Body
+        The plant and the controller's model.
+    gains : Gains
+        The gains of (23).
+    ref : Circle or Eight
+        The reference (:mod:`lib.trajectories`).
+    angle_limits : float or array_like
+        beta_max (rad), in (0, pi], one or one per pair.
+    force_limits : float or array_like, optional
+        F_max (N), > 0 (inf or None for none), one or one per pair.
+    s0 : array_like, optional
+        Start [x, y, phi, xdot, ydot, phidot] (m, rad, m/s, rad/s), (6,) or (N, 6);
+        default the paper's Table.
+    steps_per_period : int
+        Fixed steps per reference period of the compiled integrator (>= 16).
+    executor : concurrent.futures.Executor, optional
+        Where the chunks of pairs run (a process pool, a dask ``Client.get_executor()``).
+    chunk_size : int, optional
+        Points per chunk (default: two chunks per worker with an executor, else all).
+    progress : bool, optional
+        A progress bar on stderr (default None: only when run interactively).
+    **options
+        The procedure's options, :data:`LIMIT_DEFAULTS`.
+
+    Returns
+    -------
+    frame : pandas.DataFrame
+        One row per pair, the columns above.
+    runs : SwitchedRuns
+        The runs behind it, in the order of the pairs.
+    """
     unknown = set(options) - set(LIMIT_DEFAULTS)
     if unknown:
         raise TypeError(f"unknown options {sorted(unknown)}; known: {sorted(LIMIT_DEFAULTS)}")

@@ -284,21 +284,55 @@ def closed_loop_verdicts(body: Body, gains: Gains, kind: str, R, Theta, weights=
     non-finite. ``tracked``: the position is not lost and its largest error over the last block
     is at most ``position_tol`` R (0.1 R: the body stays on the path it is asked to follow).
 
-    Returns a DataFrame, one row per point: R, Theta, w_phi, regime, period, floquet (largest
-    multiplier modulus), lyapunov, lyapunov_stderr (1/s; for an orbit ln|mu_1| / (k T)),
-    slip, slip_stderr (turns per period), lost, pos_drift, pos_drift_stderr (m per period),
-    position_lost, tracked, residual, distance, turns_round, p_range (rad, over the last block),
-    p_rms (rad, RMS of p wrapped to (-pi, pi], last block), pos_rms, pos_max (m, last block),
-    periods, reason.
-
     Scale-out: with an ``executor`` (any :class:`concurrent.futures.Executor`) the points go to
     it in consecutive chunks of ``chunk_size`` (default: two chunks per worker; without an
     executor, ``chunk_size`` runs the chunks here one after another), by
     :func:`lib.parallel.map_chunks`. The field (lean or through :class:`ClosedLoop`) is chosen
     once for all points of the call and every point is decided on its own, so the frame is
     the one of the single call.
-    ``progress``: a bar over the points on stderr (:func:`lib.parallel.show_progress`; default None: only when run
-    interactively, never under pytest or in the book build).
+    ``progress``: a bar over the points on stderr (:func:`lib.parallel.show_progress`;
+    default None: only when run interactively, never under pytest or in the book build).
+
+    Parameters
+    ----------
+    body : Body
+        The plant (and the controller's model).
+    gains : Gains
+        The gains of (23).
+    kind : str or array_like
+        ``"eight"`` (28) or ``"circle"`` (27), or one per point.
+    R : float or array_like
+        Radii (m), > 0.
+    Theta : float or array_like
+        Rates (rad/s), non-zero.
+    weights : array_like
+        (w_x, w_y, w_phi) >= 0, not all zero, (3,) or (N, 3); zero weights are allowed
+        (w_x w_y = 0 runs through :class:`lib.closed_loop.ClosedLoop`).
+    z0, dz0 : array_like, optional
+        Start configuration (m, m, rad) and rates (m/s, m/s, rad/s), (3,) or (N, 3);
+        default on the reference.
+    allocation : str
+        ``"least_squares"`` (limits by projection) or ``"limited"`` (exact under limits).
+    limits : Limits, optional
+        Force and angle limits (default none).
+    executor : concurrent.futures.Executor, optional
+        Where the chunks of points run (a process pool, a dask ``Client.get_executor()``).
+    chunk_size : int, optional
+        Points per chunk (default: two chunks per worker with an executor, else all).
+    progress : bool, optional
+        A progress bar on stderr (default None: only when run interactively).
+    **options
+        The procedure's options, :data:`LOOP_VERDICT_DEFAULTS`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per point: R, Theta, w_phi, regime, period, floquet (largest
+        multiplier modulus), lyapunov, lyapunov_stderr (1/s; for an orbit ln|mu_1| / (k T)),
+        slip, slip_stderr (turns per period), lost, pos_drift, pos_drift_stderr (m per period),
+        position_lost, tracked, residual, distance, turns_round, p_range (rad, over the last block),
+        p_rms (rad, RMS of p wrapped to (-pi, pi], last block), pos_rms, pos_max (m, last block),
+        periods, reason.
     """
     kinds = np.atleast_1d(np.asarray(kind, dtype=object))
     if kinds.ndim != 1 or kinds.size == 0:

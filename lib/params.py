@@ -91,6 +91,21 @@ class Gains:
     axes (x, y, phi). Defaults are the paper's Table: Kp = 5.2, Kv = sqrt(10.4).
     The phi entries enter tau_phi only, which the position-only allocation
     (25)-(26) ignores.
+
+    Parameters
+    ----------
+    kp : float or sequence of 3 floats
+        Proportional gains (N/m, N/m, N m/rad), > 0; stored as a read-only array (3,).
+    kv : float or sequence of 3 floats
+        Derivative gains (N s/m, N s/m, N m s/rad), > 0; stored as a read-only array (3,).
+
+    Raises
+    ------
+    TypeError
+        If a gain is not a real number (a str, a bool), naming it.
+    ValueError
+        If a gain is not positive and finite (its axis index named), or has a length
+        other than 3.
     """
 
     kp: float | tuple = 5.2

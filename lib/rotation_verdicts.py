@@ -43,7 +43,24 @@ def eight_rotation_sweep(body: Body, R, Theta, **options) -> pd.DataFrame:
     slipping, chaotic, quasiperiodic or undecided, decided by :func:`rotation_verdicts`
     (Newton on the period map of (32) and the largest Lyapunov exponent). See there for
     the options and the columns (including ``lost``), and for ``executor`` and ``chunk_size``
-    (the points in chunks through any :class:`concurrent.futures.Executor`)."""
+    (the points in chunks through any :class:`concurrent.futures.Executor`) and ``progress``.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    R : array_like
+        Radii R_i (m), > 0, 1-D.
+    Theta : array_like
+        Rates Theta_i (rad/s), > 0, as long as ``R``.
+    **options
+        Keywords of :func:`rotation_verdicts`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per point, the columns of :func:`rotation_verdicts`.
+    """
     return rotation_verdicts(body, "eight", R, Theta, **options)
 
 
@@ -54,8 +71,23 @@ FIG5_GRID = MappingProxyType(dict(R=(0.25, 4.0), Theta=(0.05, 1.5), n=100))
 def fig5_map(body: Body, n: int = FIG5_GRID["n"], *, executor=None, chunk_size: int | None = None,
              progress: bool | None = None) -> pd.DataFrame:
     """The book's Fig. 5 (Chapter 5, and the report's row on it): :func:`eight_rotation_sweep`
-    on the n x n grid :data:`FIG5_GRID`, Theta varying slowest; ``executor`` and
-    ``chunk_size`` as there (the same frame, computed elsewhere in chunks)."""
+    on the n x n grid :data:`FIG5_GRID`, Theta varying slowest; ``executor``, ``chunk_size``
+    and ``progress`` as there (the same frame, computed elsewhere in chunks).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    n : int
+        Points per side (>= 2).
+    executor, chunk_size, progress
+        As in :func:`rotation_verdicts`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The frame of :func:`rotation_verdicts`, n^2 rows.
+    """
     n = _check_int("n", n, 2)
     R, Th = np.meshgrid(np.linspace(*FIG5_GRID["R"], n), np.linspace(*FIG5_GRID["Theta"], n))
     return eight_rotation_sweep(body, R.ravel(), Th.ravel(), executor=executor, chunk_size=chunk_size,
@@ -163,25 +195,55 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
     ``progress``: a bar over the points on stderr (:func:`lib.parallel.show_progress`; default None: only when run
     interactively, never under pytest or in the book build).
 
-    Returns a DataFrame, one row per point, in order: R (m), Theta (rad/s), regime;
-    period (reference periods of the orbit, periodic/slipping; 0 otherwise); range (rad:
-    max - min of p over the attracting orbit at every step (a slipping one over the k
-    periods from its point at s = 0, where p runs on by 2 pi n), extremes refined by cubic
-    Hermite interpolation (:func:`lib.rotation.sampled_range`); over the Lyapunov run otherwise);
-    floquet (largest multiplier modulus); lyapunov, lyapunov_stderr (1/s; for an orbit
-    ln|mu_1| / (k T) with no error); slip, slip_stderr (turns of p per period: n / k on
-    an orbit, the measured drift over the Lyapunov run with its batch-means error
-    otherwise); lost (bool, :func:`lib.dynamics.verdicts.heading_lost`): the heading slips
-    whole turns against the reference: the verdict is ``slipping``, or no attracting orbit is
-    reached and the drift differs from zero by more than 3 standard errors plus
-    ``slip_band`` (1e-3 turns per period); turns_round (bool,
-    :func:`lib.dynamics.verdicts.turns_round`): the other reading, range > 2 pi, whether or
-    not the heading comes back; orbit_p (rad, p at s = 0 mod 2 pi at the orbit point the
-    run is nearest to: which orbit is reached), distance (rad, from the run's last state to
-    that point), residual (rad, Newton's), mirror (rad, on the eight: the distance from
-    the orbit to its mirror image, 0 for a symmetric orbit; a positive one coexists with
-    its mirror image, a second attractor), periods (integrated), steps (per period of the fine map), verdict_steps (of the verdict map),
-    reason (why undecided).
+    Parameters
+    ----------
+    body : Body
+        The body (m, I_C, a, c, c_phi enter A, B, C of (32)).
+    kind : str
+        ``"eight"`` (28) or ``"circle"`` (27).
+    R : array_like
+        Radii R_i (m), > 0, 1-D.
+    Theta : array_like
+        Rates Theta_i (rad/s), > 0, 1-D, as long as ``R``.
+    p0, v0 : float or array_like
+        Start p(0) (rad) and dp/dt(0) (rad/s), one value or one per point.
+    h_lambda : float
+        Step bound of the fine map, h Lambda <= h_lambda (see above).
+    steps : int, optional
+        Steps per period of both maps (>= 8), instead of the bounds.
+    engine : str
+        ``"numba"`` (compiled, default) or ``"numpy"``.
+    executor : concurrent.futures.Executor, optional
+        Where the chunks of points run (a process pool, a dask ``Client.get_executor()``).
+    chunk_size : int, optional
+        Points per chunk (default: two chunks per worker with an executor, else all).
+    progress : bool, optional
+        A progress bar on stderr (default None: only when run interactively).
+    **options
+        The procedure's options, :data:`VERDICT_DEFAULTS` (and ``max_periods``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per point, in order: R (m), Theta (rad/s), regime;
+        period (reference periods of the orbit, periodic/slipping; 0 otherwise); range (rad:
+        max - min of p over the attracting orbit at every step (a slipping one over the k
+        periods from its point at s = 0, where p runs on by 2 pi n), extremes refined by cubic
+        Hermite interpolation (:func:`lib.rotation.sampled_range`); over the Lyapunov run otherwise);
+        floquet (largest multiplier modulus); lyapunov, lyapunov_stderr (1/s; for an orbit
+        ln|mu_1| / (k T) with no error); slip, slip_stderr (turns of p per period: n / k on
+        an orbit, the measured drift over the Lyapunov run with its batch-means error
+        otherwise); lost (bool, :func:`lib.dynamics.verdicts.heading_lost`): the heading slips
+        whole turns against the reference: the verdict is ``slipping``, or no attracting orbit is
+        reached and the drift differs from zero by more than 3 standard errors plus
+        ``slip_band`` (1e-3 turns per period); turns_round (bool,
+        :func:`lib.dynamics.verdicts.turns_round`): the other reading, range > 2 pi, whether or
+        not the heading comes back; orbit_p (rad, p at s = 0 mod 2 pi at the orbit point the
+        run is nearest to: which orbit is reached), distance (rad, from the run's last state to
+        that point), residual (rad, Newton's), mirror (rad, on the eight: the distance from
+        the orbit to its mirror image, 0 for a symmetric orbit; a positive one coexists with
+        its mirror image, a second attractor), periods (integrated), steps (per period of the fine map), verdict_steps (of the verdict map),
+        reason (why undecided).
     """
     _check_body_kind(body, kind)
     checks.one_of("engine", engine, sorted(ENGINES))

@@ -114,6 +114,45 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
     is located (:class:`lib.integrators.switched.SwitchedLoop`): it needs an angle
     limit below pi and the position-only law; in the result, ``beta`` while
     sliding is the Filippov average angle and ``mode`` records the side.
+
+    Parameters
+    ----------
+    body : Body
+        The plant.
+    gains : Gains
+        The gains Kp, Kv of (23).
+    ref : Reference
+        The reference (:func:`lib.trajectories.circle`, :func:`lib.trajectories.eight`, or
+        any object with ``z``, ``dz``, ``ddz`` of t).
+    t_end : float
+        End time (s), > 0.
+    z0, dz0 : array_like, optional
+        Initial configuration (x (m), y (m), phi (rad)) and its rate (m/s, m/s, rad/s), (3,).
+    limits : Limits, optional
+        Force and angle limits.
+    allocation : Allocation, optional
+        The allocation law.
+    t_eval : array_like, optional
+        Increasing output times (s) within [0, t_end].
+    integration : Integration, optional
+        Method, tolerances and switching.
+    model : Body, optional
+        The controller's model of the body.
+
+    Returns
+    -------
+    SimulationResult
+        Times t (s), configuration z and rate dz, the reference z_d, dz_d, the inputs F (N),
+        beta (rad) and the demand tau (N, N, N m) at each output time.
+
+    Raises
+    ------
+    TypeError
+        If an argument is of the wrong type (a str, a bool), naming it.
+    ValueError
+        If an argument is out of range or not finite (an array's first bad index named).
+    SimulationError
+        If the state blows up or becomes non-finite.
     """
     checks.instance("body", body, Body)
     checks.instance("gains", gains, Gains)

@@ -183,9 +183,25 @@ def lie_bracket(f: sp.MatrixBase, g: sp.MatrixBase, q) -> sp.Matrix:
     Symbols). Works for any pair of vector fields, not only this model. Each
     entry is expanded and put over a common denominator.
 
-    Raises TypeError for non-sympy input (e.g. numpy arrays, or expressions
-    in place of coordinate symbols) and ValueError when the dimensions of f,
-    g and q disagree.
+    Parameters
+    ----------
+    f, g : sympy.Matrix
+        Vector fields, n x 1 columns in the coordinates ``q`` (their units those of dq/dt).
+    q : sequence of sympy.Symbol
+        The n coordinates.
+
+    Returns
+    -------
+    sympy.Matrix
+        [f, g], n x 1, each entry expanded over a common denominator.
+
+    Raises
+    ------
+    TypeError
+        For non-sympy input (e.g. numpy arrays, or expressions in place of
+        coordinate symbols).
+    ValueError
+        When the dimensions of f, g and q disagree.
     """
     f = _column(f, "f")
     g = _column(g, "g")

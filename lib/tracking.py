@@ -41,7 +41,32 @@ def run(body: Body, gains: Gains, name: str, R: float, theta: float, n_periods: 
     """Simulate tracking of the named reference ("circle" (27) or "eight" (28)) of
     radius R (m) and rate theta (rad/s) for ``n_periods`` periods from the paper's
     initial state, sampled ``samples_per_period`` times per period. Extra keywords
-    go to :func:`lib.simulate.simulate` (e.g. ``limits``, ``integration``)."""
+    go to :func:`lib.simulate.simulate` (e.g. ``limits``, ``integration``).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    name : str
+        ``"circle"`` or ``"eight"``.
+    R : float
+        Radius (m), > 0.
+    theta : float
+        Rate (rad/s), non-zero.
+    n_periods : float
+        Reference periods to run, > 0.
+    samples_per_period : int
+        Output samples per period (>= 1).
+    **kw
+        Keywords of :func:`lib.simulate.simulate`.
+
+    Returns
+    -------
+    SimulationResult
+        The run, sampled n_periods * samples_per_period + 1 times.
+    """
     ref = make(name, R, theta)
     n_periods = checks.number("n_periods", n_periods, positive=True)
     samples_per_period = checks.integer("samples_per_period", samples_per_period, minimum=1)
@@ -157,8 +182,36 @@ def eight_sensitivity(body: Body, gains: Gains, Rs, thetas, *, n_periods: float 
     or, with an ``executor`` (any :class:`concurrent.futures.Executor`, not with
     ``workers`` > 1), the runs go to it in chunks of ``chunk_size``
     (:func:`lib.parallel.map_chunks`). Each run is on its own: the same frame either way.
-    ``progress``: a bar over the runs on stderr (:func:`lib.parallel.show_progress`; default None: only when run
-    interactively, never under pytest or in the book build).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    Rs : array_like
+        Radii R (m), > 0.
+    thetas : array_like
+        Rates theta (rad/s), non-zero.
+    n_periods : float
+        Periods per run, > 0.
+    n_steady : float
+        Last periods measured, > 0.
+    workers : int
+        Spawned processes (>= 1), not with ``executor``.
+    executor : concurrent.futures.Executor, optional
+        Where the chunks of runs go.
+    chunk_size : int, optional
+        Runs per chunk.
+    progress : bool, optional
+        A progress bar on stderr (:func:`lib.parallel.show_progress`; default None: only when
+        run interactively, never under pytest or in the book build).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per (R, theta), R varying slowest; the columns of :func:`steady_summary`
+        and p_end (rad), dp_end (rad/s), e_end (m).
     """
     checks.instance("body", body, Body)
     checks.instance("gains", gains, Gains)
@@ -219,8 +272,35 @@ def force_cap_sweep(body: Body, gains: Gains, ref: Reference, caps, *, n_periods
     ``sat_fraction`` (fraction of the samples at the cap). With an ``executor`` (any
     :class:`concurrent.futures.Executor`) the caps go to it in chunks of ``chunk_size``
     (:func:`lib.parallel.map_chunks`); each run is on its own: the same frame.
-    ``progress``: a bar over the caps on stderr (:func:`lib.parallel.show_progress`; default None: only when run
-    interactively, never under pytest or in the book build).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    ref : Reference
+        The circle or the eight.
+    caps : array_like
+        Force caps F_max (N), > 0, 1-D.
+    n_periods : int
+        Periods per run (>= 2).
+    n_steady : int
+        Last periods measured (>= 1, < n_periods).
+    samples_per_period : int
+        Samples (and fixed steps) per period (>= 16).
+    executor : concurrent.futures.Executor, optional
+        Where the chunks of caps go.
+    chunk_size : int, optional
+        Caps per chunk.
+    progress : bool, optional
+        A progress bar on stderr (:func:`lib.parallel.show_progress`; default None: only when
+        run interactively, never under pytest or in the book build).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per cap: cap (N), pos_err_max (m), ex_amp (m), ey_amp (m), sat_fraction.
     """
     caps = np.atleast_1d(checks.array("caps", caps, positive=True))
     if caps.ndim != 1 or caps.size == 0:

@@ -188,13 +188,55 @@ def position_kinematics(ref: Reference):
 
 
 def circle(R: float = 2.0, theta: float = math.pi / 4) -> Circle:
-    """The circle reference of eq. (27); defaults from the paper's Table."""
+    """The circle reference of eq. (27); defaults from the paper's Table.
+
+    Parameters
+    ----------
+    R : float
+        Radius (m), > 0.
+    theta : float
+        Angular rate Theta (rad/s), non-zero (negative runs the circle clockwise).
+
+    Returns
+    -------
+    Circle
+        The reference: position z_d(t) (m, m, rad) with its first two derivatives
+        (``z``, ``dz``, ``ddz``) and its ``period`` 2 pi / abs(theta) (s).
+
+    Raises
+    ------
+    TypeError
+        If R or theta is not a real number.
+    ValueError
+        If R is not positive and finite, or theta is zero or not finite.
+    """
     return Circle(R, theta)
 
 
 def eight(R: float = 2.0, theta: float = math.pi / 4) -> Eight:
     """The figure-eight reference of eq. (28). The paper does not state R and
-    theta for its Fig. 3; the defaults reuse the circle's (see Chapter 3)."""
+    theta for its Fig. 3; the defaults reuse the circle's (see Chapter 3).
+
+    Parameters
+    ----------
+    R : float
+        Size of the eight (m), > 0: x_d = (R / 2) sin(2 Theta t), y_d = R sin(Theta t).
+    theta : float
+        Angular rate Theta (rad/s), non-zero.
+
+    Returns
+    -------
+    Eight
+        The reference, as :func:`circle` returns one; the heading is the continuous
+        tangent angle (rad).
+
+    Raises
+    ------
+    TypeError
+        If R or theta is not a real number.
+    ValueError
+        If R is not positive and finite, or theta is zero or not finite.
+    """
     return Eight(R, theta)
 
 
@@ -202,7 +244,22 @@ NAMES = {"circle": circle, "eight": eight}
 
 
 def make(name: str, R: float, theta: float) -> Reference:
-    """Build a reference by name (``"circle"`` or ``"eight"``)."""
+    """Build a reference by name.
+
+    Parameters
+    ----------
+    name : str
+        ``"circle"`` (27) or ``"eight"`` (28).
+    R : float
+        Radius (m), > 0.
+    theta : float
+        Angular rate (rad/s), non-zero.
+
+    Returns
+    -------
+    Reference
+        :func:`circle` or :func:`eight` of (R, theta).
+    """
     try:
         factory = NAMES[name]
     except (KeyError, TypeError):

@@ -67,7 +67,24 @@ def verdict_runs(body: Body, gains: Gains, runs: dict, **options) -> dict:
     several). ``runs`` maps a name to a dict with ``kind``, ``R``, ``Theta`` and optionally
     ``weights`` ((3,) or (N, 3)), ``z0``, ``dz0`` ((3,) or (N, 3)); ``options`` go to
     :func:`closed_loop_verdicts` (``executor`` and ``chunk_size`` too: the points of all runs are
-    chunked together). Returns the frames by name, each indexed from 0."""
+    chunked together).
+
+    Parameters
+    ----------
+    body : Body
+        The plant.
+    gains : Gains
+        The gains of (23).
+    runs : dict
+        Name -> dict(kind, R (m), Theta (rad/s), [weights, z0 (m, m, rad), dz0]).
+    **options
+        Keywords of :func:`closed_loop_verdicts` (``executor``, ``chunk_size``, ``progress`` too).
+
+    Returns
+    -------
+    dict of pandas.DataFrame
+        The frames by name, each indexed from 0.
+    """
     if not runs:
         raise ValueError("no runs given")
     parts, sizes = [], []
