@@ -53,7 +53,7 @@ def _canonical(modname: str | None, target: str) -> str | None:
         except AttributeError:
             return None
         owner, qual = getattr(obj, "__module__", None), getattr(obj, "__qualname__", None)
-        if owner and qual and f"{owner}.{qual}" != target:
+        if owner and qual and f"{owner}.{qual}" not in (target, f"{modname}.{target}"):
             return f"{owner}.{qual}"
         return None
     return None

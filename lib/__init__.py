@@ -19,5 +19,12 @@ Where to start (import the modules you need; ``import lib`` itself loads nothing
 * ``lib.weighting.closed_loop_verdicts``: the verdicts on the full closed loop, for any
   allocation weights (Chapter 6).
 
-README.md's "Where to start in the library" runs a small Fig. 5 map and a capped circle.
+Every sweep takes ``executor=`` (any ``concurrent.futures.Executor``, a dask cluster's
+included; ``lib.parallel.map_chunks``) and ``progress=`` (a progress bar, shown by default
+only when run interactively: ``lib.parallel.show_progress``). Every public function checks
+its arguments with ``lib.checks``: a wrong type is a ``TypeError``, a wrong value a
+``ValueError``, each naming the argument (and the index in an array).
+
+README.md's "Where to start in the library" runs a small Fig. 5 map and a capped circle;
+the book's "Library reference" page (``reference.md``) is generated from the docstrings.
 """

@@ -1,0 +1,71 @@
+"""The "Library reference" page (reference.md): every module of the library is on it, the
+public API has numpydoc Parameters and Returns sections, and the page's docstring filter
+(_ext/docstring_text.py) leaves code alone. The page builds with -W -n as part of the book
+(tests/test_book.py)."""
+
+import importlib
+import inspect
+import pkgutil
+import re
+import sys
+from pathlib import Path
+
+import pytest
+
+import lib
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "_ext"))
+import docstring_text  # noqa: E402
+
+#: the API other code calls (issue 21, "Keep stable") and the sweeps
+DOCUMENTED = [
+    "params.Body", "params.Gains", "trajectories.circle", "trajectories.eight", "trajectories.make",
+    "allocation.Limits", "allocation.allocate", "allocation.allocate_least_squares", "allocation.allocate_limited",
+    "control.computed_torque", "simulate.simulate", "symbolic.lie_bracket", "closed_loop.ClosedLoop.of",
+    "rotation_verdicts.rotation_verdicts", "rotation_verdicts.eight_rotation_sweep", "rotation_verdicts.fig5_map",
+    "limits.limit_verdicts", "limits.sweep_angle_limit", "loop_verdicts.closed_loop_verdicts",
+    "weighting.verdict_runs", "tracking.run", "tracking.eight_sensitivity", "tracking.force_cap_sweep",
+    "parallel.map_chunks", "parallel.map_in_processes", "parallel.show_progress",
+    "checks.number", "checks.integer", "checks.array", "checks.one_of", "checks.flag", "checks.instance",
+]
+
+
+def _object(path: str):
+    mod, *attrs = path.split(".")
+    obj = importlib.import_module(f"lib.{mod}")
+    for a in attrs:
+        obj = getattr(obj, a)
+    return obj
+
+
+@pytest.mark.parametrize("path", DOCUMENTED)
+def test_public_api_has_numpydoc_parameters_and_returns(path):
+    doc = inspect.getdoc(_object(path))
+    assert re.search(r"^Parameters\n-{10}$", doc, re.M), f"{path}: no Parameters section"
+    if not inspect.isclass(_object(path)):
+        assert re.search(r"^Returns\n-{7}$", doc, re.M), f"{path}: no Returns section"
+
+
+def test_every_module_is_on_the_reference_page():
+    page = (ROOT / "reference.md").read_text()
+    on_page = set(re.findall(r"^\.\. automodule:: (\S+)$", page, re.M))
+    modules = {m.name for m in pkgutil.walk_packages(lib.__path__, "lib.") if not m.name.startswith("lib.paper")}
+    assert modules - on_page == set(), "add these modules to reference.md"
+    assert on_page - modules - {"lib"} == set()
+
+
+def test_bars_are_escaped_outside_code_and_roles():
+    esc = docstring_text.escape_bars
+    assert esc("|beta| <= beta_max") == r"\|beta\| <= beta_max"
+    assert esc(r"already \|x\|") == r"already \|x\|"
+    assert esc("``|x|`` and :func:`a|b` and `y|z`") == "``|x|`` and :func:`a|b` and `y|z`"
+    assert esc("ln|mu_1| / (k T), ``a``, |p|") == r"ln\|mu_1\| / (k T), ``a``, \|p\|"
+
+
+def test_a_reexported_name_resolves_where_it_is_defined():
+    canon = docstring_text._canonical
+    assert canon("lib.weighting", "closed_loop_verdicts") == "lib.loop_verdicts.closed_loop_verdicts"
+    assert canon(None, "lib.limits.switched_runs") == "lib.switched_runs.switched_runs"
+    assert canon("lib.loop_verdicts", "closed_loop_verdicts") is None      # defined there: nothing to do
+    assert canon("lib.limits", "no_such_name") is None
