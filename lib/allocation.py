@@ -153,7 +153,30 @@ def _checked_body(body) -> Body:
 
 def least_squares_problem(tau, phi, body: Body, weights):
     """The weighted least-squares problem of :func:`allocate_least_squares`, validated;
-    see ``_ls_kernel``."""
+    see ``_ls_kernel``.
+
+    Parameters
+    ----------
+    tau : array_like
+        Demanded generalized force [tau_x (N), tau_y (N), tau_phi (N m)], shape (..., 3).
+    phi : array_like
+        Heading (rad).
+    body : Body
+        The body.
+    weights : array_like
+        (w_x, w_y, w_phi) >= 0, not all zero, (3,) or (..., 3).
+
+    Returns
+    -------
+    u_star : numpy.ndarray
+        The unconstrained optimum (u1, u2) (N), shape (..., 2).
+    G : numpy.ndarray
+        A^T A, shape (..., 2, 2).
+    r : numpy.ndarray
+        A^T b (N), shape (..., 2).
+    bb : numpy.ndarray
+        |b|^2 (N^2), shape (...).
+    """
     tau = _check_tau(tau)
     w = _check_weights(weights)
     return _ls_kernel(tau, checks.array("phi", phi), _checked_body(body), np.sqrt(w))
@@ -198,7 +221,21 @@ def _pinv_rows(u, regular, A, b):
 
 
 def residual(u, G, r, bb) -> np.ndarray:
-    """J(u) = u^T G u - 2 r^T u + |b|^2 of :func:`least_squares_problem`, for u of shape (..., 2)."""
+    """J(u) = u^T G u - 2 r^T u + |b|^2 of :func:`least_squares_problem`, for u of shape (..., 2).
+
+    Parameters
+    ----------
+    u : array_like
+        Inputs (u1, u2) = (F cos beta, F sin beta) (N), shape (..., 2).
+    G, r, bb : array_like
+        The problem's A^T A (..., 2, 2), A^T b (..., 2) and |b|^2 (...), as
+        :func:`least_squares_problem` returns them.
+
+    Returns
+    -------
+    numpy.ndarray
+        J(u), the weighted squared residual (N^2), shape (...).
+    """
     return np.einsum("...i,...ij,...j->...", u, G, u) - 2 * np.einsum("...i,...i->...", r, u) + bb
 
 

@@ -28,7 +28,18 @@ Kinematics = Callable[[object], tuple]
 
 
 def reference_of(ref) -> Kinematics:
-    """The kinematics t -> (z_d, dz_d, ddz_d) of a reference object (:mod:`lib.trajectories`)."""
+    """The kinematics t -> (z_d, dz_d, ddz_d) of a reference object (:mod:`lib.trajectories`).
+
+    Parameters
+    ----------
+    ref : Reference
+        An object with ``z``, ``dz``, ``ddz`` of t (s).
+
+    Returns
+    -------
+    callable
+        t (s) -> (z_d (m, m, rad), dz_d, ddz_d), each (..., 3).
+    """
     return lambda t: (ref.z(t), ref.dz(t), ref.ddz(t))
 
 

@@ -66,7 +66,24 @@ def computed_torque(body: Body, gains: Gains, ref, t, z, dz) -> np.ndarray:
 
 def computed_torque_from(body: Body, gains: Gains, z_d, dz_d, ddz_d, z, dz) -> np.ndarray:
     """Eq. (23) from the reference values themselves: z_d, dz_d, ddz_d and the actual
-    z, dz, all of shape (..., 3) (broadcast); see :func:`computed_torque`."""
+    z, dz, all of shape (..., 3) (broadcast); see :func:`computed_torque`.
+
+    Parameters
+    ----------
+    body : Body
+        The controller's model of the body.
+    gains : Gains
+        The gains Kp, Kv.
+    z_d, dz_d, ddz_d : array_like
+        The reference configuration (m, m, rad) and its first two derivatives, (..., 3).
+    z, dz : array_like
+        The actual configuration and its rate, (..., 3).
+
+    Returns
+    -------
+    numpy.ndarray
+        tau = [tau_x (N), tau_y (N), tau_phi (N m)], shape (..., 3).
+    """
     z = np.asarray(z, dtype=float)
     dz = np.asarray(dz, dtype=float)
     m = np.array([body.m, body.m, body.I])
@@ -77,7 +94,24 @@ def computed_torque_rate(body: Body, gains: Gains, dz_d, ddz_d, dddz_d, dz, ddz)
     """Time derivative of (23): M dddz_d + N(ddz) + Kv (ddz_d - ddz) + Kp (dz_d - dz) (N/s,
     N m/s), from the reference's rate, acceleration and jerk and the actual rate and
     acceleration, all of shape (..., 3) (broadcast). The switched integrator needs it for
-    the rate of its switching function (:mod:`lib.integrators.switched`)."""
+    the rate of its switching function (:mod:`lib.integrators.switched`).
+
+    Parameters
+    ----------
+    body : Body
+        The controller's model of the body.
+    gains : Gains
+        The gains Kp, Kv.
+    dz_d, ddz_d, dddz_d : array_like
+        The reference's rate, acceleration and jerk (m/s, m/s^2, m/s^3; rad for the heading), (..., 3).
+    dz, ddz : array_like
+        The actual rate and acceleration, (..., 3).
+
+    Returns
+    -------
+    numpy.ndarray
+        d tau / dt = [N/s, N/s, N m/s], shape (..., 3).
+    """
     m = np.array([body.m, body.m, body.I])
     return (m * np.asarray(dddz_d, dtype=float) + body.drag * np.asarray(ddz, dtype=float)
             + gains.kv * (ddz_d - np.asarray(ddz, dtype=float)) + gains.kp * (dz_d - np.asarray(dz, dtype=float)))
@@ -90,6 +124,24 @@ def error_dynamics_solution(body: Body, gains: Gains, e0, de0, t) -> np.ndarray:
     ``t`` is an array of times (s). Returns e(t), shape t.shape + (3,). Each
     axis is the free response of a linear oscillator, computed with the
     matrix exponential of its companion matrix.
+
+    Parameters
+    ----------
+    body : Body
+        The body (its m and I_C).
+    gains : Gains
+        The gains Kp, Kv.
+    e0 : array_like
+        Errors z_d - z at t = 0 (m, m, rad), length 3.
+    de0 : array_like
+        Their rates (m/s, m/s, rad/s), length 3.
+    t : array_like
+        Times (s).
+
+    Returns
+    -------
+    numpy.ndarray
+        e(t) (m, m, rad), shape t.shape + (3,).
     """
     t = np.asarray(t, dtype=float)
     m = np.array([body.m, body.m, body.I])

@@ -30,6 +30,21 @@ def generalized_force(F, beta, phi) -> np.ndarray:
     """Q of eq. (22) without the lever arm: [F cos(phi+beta), F sin(phi+beta), F sin(beta)].
 
     Multiply the last entry by ``a`` to get the torque (N m); see :func:`config_accel`.
+
+    Parameters
+    ----------
+    F : array_like
+        Force magnitude (N).
+    beta : array_like
+        Force angle to the body axis (rad).
+    phi : array_like
+        Heading (rad).
+
+    Returns
+    -------
+    numpy.ndarray
+        [F cos(phi+beta) (N), F sin(phi+beta) (N), F sin(beta) (N)], shape (..., 3) of the
+        broadcast inputs.
     """
     F, beta, phi = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (F, beta, phi)))
     return np.stack([F * np.cos(phi + beta), F * np.sin(phi + beta), F * np.sin(beta)], axis=-1)
@@ -39,6 +54,18 @@ def input_matrix(phi, body: Body) -> np.ndarray:
     """B(phi) with Q = B(phi) u, u = (u1, u2) = (F cos beta, F sin beta), eq. (22).
 
     B = [[cos phi, -sin phi], [sin phi, cos phi], [0, a]]; shape phi.shape + (3, 2).
+
+    Parameters
+    ----------
+    phi : array_like
+        Heading (rad).
+    body : Body
+        The body (its lever arm a (m)).
+
+    Returns
+    -------
+    numpy.ndarray
+        B(phi), shape phi.shape + (3, 2): Q (N, N, N m) = B u with u in N.
     """
     phi = np.asarray(phi, dtype=float)
     c, s = np.cos(phi), np.sin(phi)
@@ -52,6 +79,24 @@ def config_accel(body: Body, z, dz, F, beta) -> np.ndarray:
     ``F`` (N) is the force magnitude and ``beta`` (rad) its angle to the body
     axis; m xddot + c xdot = F cos(phi+beta), m yddot + c ydot = F sin(phi+beta),
     I_C phiddot + c_phi phidot = F a sin(beta).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    z : array_like
+        Configuration [x (m), y (m), phi (rad)], shape (..., 3).
+    dz : array_like
+        Its rate (m/s, m/s, rad/s), shape (..., 3).
+    F : array_like
+        Force magnitude (N).
+    beta : array_like
+        Force angle to the body axis (rad).
+
+    Returns
+    -------
+    numpy.ndarray
+        ddz = [xddot (m/s^2), yddot (m/s^2), phiddot (rad/s^2)], shape (..., 3).
     """
     z = _last_axis(z, 3, "z")
     dz = _last_axis(dz, 3, "dz")
@@ -69,6 +114,18 @@ def f(body: Body, q) -> np.ndarray:
                 -c/m v1 + v2 omega, -c/m v2 - v1 omega, -c_phi/I_C omega].
 
     The fifth row differs in sign from the printed (6): see :func:`f_printed`.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    q : array_like
+        State [x (m), y (m), phi (rad), v1 (m/s), v2 (m/s), omega (rad/s)], shape (..., 6).
+
+    Returns
+    -------
+    numpy.ndarray
+        f(q), shape (..., 6), in the units of dq/dt.
     """
     q = _last_axis(q, 6, "q")
     _, _, phi, v1, v2, w = np.moveaxis(q, -1, 0)
@@ -84,7 +141,20 @@ def f(body: Body, q) -> np.ndarray:
 
 
 def f_printed(body: Body, q) -> np.ndarray:
-    """The drift exactly as printed in eq. (6), with +v1 omega in the v2 row (a typo)."""
+    """The drift exactly as printed in eq. (6), with +v1 omega in the v2 row (a typo).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    q : array_like
+        State [x, y, phi, v1, v2, omega] (m, m, rad, m/s, m/s, rad/s), shape (..., 6).
+
+    Returns
+    -------
+    numpy.ndarray
+        The printed f(q), shape (..., 6).
+    """
     out = f(body, q)
     q = np.asarray(q, dtype=float)
     out[..., 4] += 2.0 * q[..., 3] * q[..., 5]
@@ -92,12 +162,34 @@ def f_printed(body: Body, q) -> np.ndarray:
 
 
 def g1(body: Body) -> np.ndarray:
-    """Input field of u1 = F cos(beta), eq. (9): [0, 0, 0, 1/m, 0, 0]."""
+    """Input field of u1 = F cos(beta), eq. (9): [0, 0, 0, 1/m, 0, 0].
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+
+    Returns
+    -------
+    numpy.ndarray
+        g1, shape (6,), per newton of u1 (1/kg in the v1 row).
+    """
     return np.array([0.0, 0.0, 0.0, 1.0 / body.m, 0.0, 0.0])
 
 
 def g2(body: Body) -> np.ndarray:
-    """Input field of u2 = F sin(beta), eq. (10): [0, 0, 0, 0, 1/m, a/I_C]."""
+    """Input field of u2 = F sin(beta), eq. (10): [0, 0, 0, 0, 1/m, a/I_C].
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+
+    Returns
+    -------
+    numpy.ndarray
+        g2, shape (6,), per newton of u2 (1/kg in the v2 row, m/(kg m^2) in the omega row).
+    """
     return np.array([0.0, 0.0, 0.0, 0.0, 1.0 / body.m, body.a / body.I])
 
 
@@ -105,6 +197,24 @@ def state_rhs(body: Body, q, F, beta, *, printed: bool = False) -> np.ndarray:
     """qdot = f(q) + g1 u1 + g2 u2, eq. (5), with u1 = F cos(beta), u2 = F sin(beta) (7)-(8).
 
     ``printed=True`` uses the drift as printed in (6), for comparison only.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    q : array_like
+        State [x, y, phi, v1, v2, omega] (m, m, rad, m/s, m/s, rad/s), shape (..., 6).
+    F : array_like
+        Force magnitude (N).
+    beta : array_like
+        Force angle to the body axis (rad).
+    printed : bool
+        Use the drift as printed in (6).
+
+    Returns
+    -------
+    numpy.ndarray
+        dq/dt, shape (..., 6).
     """
     drift = f_printed(body, q) if printed else f(body, q)
     u1 = np.asarray(F, dtype=float) * np.cos(beta)
@@ -116,6 +226,18 @@ def state_from_config(z, dz) -> np.ndarray:
     """State q = [x, y, phi, v1, v2, omega] from configuration z and its rate dz.
 
     (v1, v2) is the inertial velocity (xdot, ydot) rotated by -phi into the body frame.
+
+    Parameters
+    ----------
+    z : array_like
+        Configuration [x (m), y (m), phi (rad)], shape (..., 3).
+    dz : array_like
+        Its rate (m/s, m/s, rad/s), shape (..., 3).
+
+    Returns
+    -------
+    numpy.ndarray
+        q = [x, y, phi, v1 (m/s), v2 (m/s), omega (rad/s)], shape (..., 6).
     """
     z, dz = np.broadcast_arrays(_last_axis(z, 3, "z"), _last_axis(dz, 3, "dz"))
     phi = z[..., 2]
@@ -126,7 +248,20 @@ def state_from_config(z, dz) -> np.ndarray:
 
 
 def config_from_state(q) -> tuple[np.ndarray, np.ndarray]:
-    """Inverse of :func:`state_from_config`: returns (z, dz)."""
+    """Inverse of :func:`state_from_config`: returns (z, dz).
+
+    Parameters
+    ----------
+    q : array_like
+        State [x, y, phi, v1, v2, omega] (m, m, rad, m/s, m/s, rad/s), shape (..., 6).
+
+    Returns
+    -------
+    z : numpy.ndarray
+        Configuration [x (m), y (m), phi (rad)], shape (..., 3).
+    dz : numpy.ndarray
+        Its rate (m/s, m/s, rad/s), shape (..., 3).
+    """
     q = _last_axis(q, 6, "q")
     phi, v1, v2 = q[..., 2], q[..., 3], q[..., 4]
     c, s = np.cos(phi), np.sin(phi)

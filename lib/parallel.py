@@ -72,7 +72,18 @@ def _bar(total: int, desc: str | None):
 
 
 def process_pool(workers: int) -> ProcessPoolExecutor:
-    """A pool of ``workers`` *spawned* processes (safe after numba has run in this one)."""
+    """A pool of ``workers`` *spawned* processes (safe after numba has run in this one).
+
+    Parameters
+    ----------
+    workers : int
+        Processes (>= 1).
+
+    Returns
+    -------
+    concurrent.futures.ProcessPoolExecutor
+        The pool (use it in a ``with`` block).
+    """
     return ProcessPoolExecutor(max_workers=_check_workers(workers), mp_context=multiprocessing.get_context("spawn"))
 
 
@@ -119,7 +130,18 @@ def map_in_processes(fn: Callable, items: Sequence, workers: int, progress: bool
 def executor_workers(executor: Executor) -> int:
     """How many tasks ``executor`` runs at once, as far as it tells: a process or thread
     pool's ``max_workers``, a dask ``ClientExecutor``'s threads over all its workers;
-    otherwise the CPUs of this machine."""
+    otherwise the CPUs of this machine.
+
+    Parameters
+    ----------
+    executor : concurrent.futures.Executor
+        The executor.
+
+    Returns
+    -------
+    int
+        Tasks it runs at once (>= 1).
+    """
     n = getattr(executor, "_max_workers", None)
     client = getattr(executor, "_client", None)
     if n is None and client is not None:
@@ -131,7 +153,20 @@ def executor_workers(executor: Executor) -> int:
 
 
 def chunk_slices(n: int, chunk_size: int) -> list[slice]:
-    """Consecutive slices of ``range(n)``, each ``chunk_size`` long (the last shorter)."""
+    """Consecutive slices of ``range(n)``, each ``chunk_size`` long (the last shorter).
+
+    Parameters
+    ----------
+    n : int
+        Points.
+    chunk_size : int
+        Points per chunk.
+
+    Returns
+    -------
+    list of slice
+        ceil(n / chunk_size) slices covering range(n) in order.
+    """
     return [slice(a, min(a + chunk_size, n)) for a in range(0, n, chunk_size)]
 
 
@@ -237,5 +272,16 @@ def _cut(arrays, s: slice) -> list:
 
 
 def concat_frames(parts: Sequence[pd.DataFrame]) -> pd.DataFrame:
-    """The frames of the chunks of :func:`map_chunks` as one, indexed from 0 (one frame as it is)."""
+    """The frames of the chunks of :func:`map_chunks` as one, indexed from 0 (one frame as it is).
+
+    Parameters
+    ----------
+    parts : sequence of pandas.DataFrame
+        The chunks' frames, in order.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One frame.
+    """
     return parts[0] if len(parts) == 1 else pd.concat(list(parts), ignore_index=True)

@@ -221,6 +221,30 @@ def simulate_open_loop(body: Body, F, beta, q0, t_end: float, *, form: str = "co
     initial state [x, y, phi, v1, v2, omega]. Returns (t, q) with q of shape
     (n, 6) in body-frame state coordinates whatever the form, so the three can
     be compared directly.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    F, beta : callable
+        Inputs of time t (s): force (N) and its angle to the body axis (rad).
+    q0 : array_like
+        Initial state [x, y, phi, v1, v2, omega] (m, m, rad, m/s, m/s, rad/s), (6,).
+    t_end : float
+        End time (s), > 0.
+    form : str
+        ``"config"``, ``"state"`` or ``"printed"`` (:data:`OPEN_LOOP_FORMS`).
+    t_eval : array_like, optional
+        Output times (s), default 20 per second.
+    rtol, atol : float
+        Tolerances of ``solve_ivp``.
+
+    Returns
+    -------
+    t : numpy.ndarray
+        Times (s), (n,).
+    q : numpy.ndarray
+        Body-frame states, (n, 6).
     """
     if form not in OPEN_LOOP_FORMS:
         raise ValueError(f"unknown model form {form!r}; known: {OPEN_LOOP_FORMS}")
@@ -277,6 +301,24 @@ def open_loop_comparison(body: Body, t_end: float, *, F=_demo_force, beta=_demo_
     Defaults are the smooth inputs of Chapter 1, F(t) = 1 + 0.5 sin t (N) and
     beta(t) = 0.8 sin 0.7t (rad), from q0 = :data:`DEMO_Q0`, chosen so that the
     body both translates and turns. Returns (t, {form: q}) with q of shape (n, 6).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    t_end : float
+        End time (s), > 0.
+    F, beta : callable
+        Inputs of time t (s): force (N) and angle (rad).
+    q0 : array_like
+        Initial state (6,).
+
+    Returns
+    -------
+    t : numpy.ndarray
+        Times (s), (n,).
+    q : dict of numpy.ndarray
+        The body-frame states (n, 6) of each form, by name.
     """
     runs = {form: simulate_open_loop(body, F, beta, q0, t_end, form=form) for form in OPEN_LOOP_FORMS}
     return runs["config"][0], {form: q for form, (_, q) in runs.items()}

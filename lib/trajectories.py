@@ -113,6 +113,18 @@ def circle_position(R, theta, t, cos=np.cos, sin=np.sin) -> tuple:
     The one definition of (27)'s position, for arrays; with ``cos=math.cos,
     sin=math.sin`` the same formulas run on Python floats at scalar speed (the
     switched integrator calls them at every step, see :func:`position_kinematics`).
+
+    Parameters
+    ----------
+    R, theta, t : array_like or float
+        Radius (m), rate (rad/s), time (s).
+    cos, sin : callable
+        The cosine and sine to use (numpy's, or math's for floats).
+
+    Returns
+    -------
+    tuple
+        (x_d, y_d, vx_d, vy_d, ax_d, ay_d, jx_d, jy_d).
     """
     s = theta * t
     c, sn = cos(s), sin(s)
@@ -122,7 +134,20 @@ def circle_position(R, theta, t, cos=np.cos, sin=np.sin) -> tuple:
 
 def eight_position(R, theta, t, cos=np.cos, sin=np.sin) -> tuple:
     """Position of the eight (28), x_d = R/2 sin 2 theta t, y_d = R sin theta t, and its
-    first three time derivatives, ordered as in :func:`circle_position`."""
+    first three time derivatives, ordered as in :func:`circle_position`.
+
+    Parameters
+    ----------
+    R, theta, t : array_like or float
+        Size (m), rate (rad/s), time (s).
+    cos, sin : callable
+        The cosine and sine to use.
+
+    Returns
+    -------
+    tuple
+        (x_d, y_d, vx_d, vy_d, ax_d, ay_d, jx_d, jy_d) (m, m/s, m/s^2, m/s^3).
+    """
     s = theta * t
     c1, s1, c2, s2 = cos(s), sin(s), cos(2 * s), sin(2 * s)
     return (0.5 * R * s2, R * s1, R * theta * c2, R * theta * c1, -2 * R * theta**2 * s2, -R * theta**2 * s1,
@@ -135,6 +160,21 @@ def circle_kinematics(R, theta, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     Unvalidated array form behind :class:`Circle`, for batch computations;
     each array has shape broadcast(R, theta, t) + (3,). The heading is
     phi_d = theta t + pi/2.
+
+    Parameters
+    ----------
+    R : array_like
+        Radius (m).
+    theta : array_like
+        Angular rate (rad/s).
+    t : array_like
+        Time (s).
+
+    Returns
+    -------
+    z_d, dz_d, ddz_d : numpy.ndarray
+        Position (m, m, rad), velocity (m/s, m/s, rad/s) and acceleration (m/s^2, m/s^2,
+        rad/s^2), each of shape broadcast(R, theta, t) + (3,).
     """
     R, th, t = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (R, theta, t)))
     x, y, vx, vy, ax, ay, _, _ = circle_position(R, th, t)
@@ -153,6 +193,20 @@ def eight_kinematics(R, theta, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     phi_d' = theta N / D and phi_d'' = theta^2 (N' D - N D') / D^2 with
     N = 2 cos s sin 2s - cos 2s sin s, D = cos^2 2s + cos^2 s,
     N' = 3 cos s cos 2s, D' = -2 sin 4s - sin 2s.
+
+    Parameters
+    ----------
+    R : array_like
+        Size (m).
+    theta : array_like
+        Angular rate (rad/s).
+    t : array_like
+        Time (s).
+
+    Returns
+    -------
+    z_d, dz_d, ddz_d : numpy.ndarray
+        As :func:`circle_kinematics`.
     """
     R, th, t = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (R, theta, t)))
     x, y, vx, vy, ax, ay, _, _ = eight_position(R, th, t)
@@ -174,7 +228,18 @@ def position_kinematics(ref: Reference):
     position (m), velocity, acceleration and jerk (needed by the rate of the switching
     function of :class:`lib.integrators.switched.SwitchedLoop`). Exact for the circle
     (27) and the eight (28) (:func:`circle_position`, :func:`eight_position`); for
-    another reference the jerk is a fourth-order central difference of ``ref.ddz``."""
+    another reference the jerk is a fourth-order central difference of ``ref.ddz``.
+
+    Parameters
+    ----------
+    ref : Reference
+        The reference.
+
+    Returns
+    -------
+    callable
+        t (s) -> the 8-tuple of floats above.
+    """
     if isinstance(ref, _Path):
         position, R, th = POSITIONS[ref._kind], ref.R, ref.theta
         return lambda t: position(R, th, float(t), math.cos, math.sin)
@@ -285,7 +350,20 @@ def eight_heading_fourier(n_harmonics: int = 9, n_samples: int = 4096) -> np.nda
     tangent angle phi_d(s) = pi + atan2(-cos s, -cos 2s) (rad), s = Theta t, by FFT.
 
     phi_d is even in s, so phi_d = a_0 + sum_k a_k cos(k s); the half-period
-    symmetry phi_d(s + pi) - pi = -(phi_d(s) - pi) leaves only odd k."""
+    symmetry phi_d(s + pi) - pi = -(phi_d(s) - pi) leaves only odd k.
+
+    Parameters
+    ----------
+    n_harmonics : int
+        Highest harmonic (>= 0).
+    n_samples : int
+        FFT samples per period (>= 2 n_harmonics + 2).
+
+    Returns
+    -------
+    numpy.ndarray
+        a_0..a_{n_harmonics} (rad), shape (n_harmonics + 1,).
+    """
     n_harmonics = checks.integer("n_harmonics", n_harmonics, minimum=0)
     n_samples = checks.integer("n_samples", n_samples, minimum=2 * n_harmonics + 2)
     s = 2 * np.pi * np.arange(n_samples) / n_samples
@@ -297,6 +375,19 @@ def eight_heading_fourier(n_harmonics: int = 9, n_samples: int = 4096) -> np.nda
 
 
 def heading_series(coefficients: dict, s) -> np.ndarray:
-    """Evaluate a cosine series {k: a_k} at phases s (rad)."""
+    """Evaluate a cosine series {k: a_k} at phases s (rad).
+
+    Parameters
+    ----------
+    coefficients : dict
+        {k: a_k (rad)}.
+    s : array_like
+        Phases (rad).
+
+    Returns
+    -------
+    numpy.ndarray
+        sum_k a_k cos(k s) (rad), of the shape of s.
+    """
     s = np.asarray(s, dtype=float)
     return sum(a * np.cos(k * s) for k, a in coefficients.items())
