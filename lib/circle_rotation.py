@@ -38,6 +38,18 @@ def circle_critical_radius(body: Body, theta: float) -> float:
 
     Equilibria of (33) exist iff R >= R_crit; for R > R_crit there are two per
     turn, one stable and one saddle. ``theta`` > 0 in rad/s.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    theta : float
+        Angular rate (rad/s), > 0.
+
+    Returns
+    -------
+    float
+        R_crit (m).
     """
     _check_circle_args(body, None, theta)
     return body.c_phi / (body.a * math.hypot(body.m * theta, body.c))
@@ -50,6 +62,20 @@ def circle_equilibria(body: Body, R: float, theta: float) -> tuple[float, float]
     sin(p - gamma) = -k, so p_stable = gamma - arcsin k and
     p_saddle = gamma + pi + arcsin k, both wrapped to (-pi, pi].
     Raises ValueError when R < R_crit (no equilibrium: the rotation slips for ever).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    R : float
+        Radius (m), >= R_crit.
+    theta : float
+        Angular rate (rad/s), > 0.
+
+    Returns
+    -------
+    p_stable, p_saddle : float
+        The two equilibria (rad), in (-pi, pi].
     """
     _check_circle_args(body, R, theta)
     r_crit = circle_critical_radius(body, theta)
@@ -62,7 +88,24 @@ def circle_equilibria(body: Body, R: float, theta: float) -> tuple[float, float]
 
 
 def circle_jacobian(body: Body, R: float, theta: float, p0: float) -> np.ndarray:
-    """Jacobian of (33) (corrected) at (p0, 0): the matrix of the linearisation (34)."""
+    """Jacobian of (33) (corrected) at (p0, 0): the matrix of the linearisation (34).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    R : float
+        Radius (m), > 0.
+    theta : float
+        Angular rate (rad/s), > 0.
+    p0 : float
+        The equilibrium (rad).
+
+    Returns
+    -------
+    numpy.ndarray
+        The 2 x 2 Jacobian of (p, p') -> (p', p'') (1/s, 1/s^2).
+    """
     k21 = -body.a * R * theta / body.I * (body.c * math.cos(p0) + body.m * theta * math.sin(p0))
     return np.array([[0.0, 1.0], [k21, -body.c_phi / body.I]])
 
@@ -70,7 +113,22 @@ def circle_jacobian(body: Body, R: float, theta: float, p0: float) -> np.ndarray
 def circle_eigenvalues(body: Body, R: float, theta: float) -> np.ndarray:
     """Eigenvalues (1/s) of the linearisation (34) at the stable equilibrium:
     the roots of (35), lambda^2 + c_phi/I lambda + theta/I sqrt(a^2 R^2 (m^2 theta^2 + c^2) - c_phi^2).
-    Complex array of two values, sorted by real part."""
+    Complex array of two values, sorted by real part.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    R : float
+        Radius (m), >= R_crit.
+    theta : float
+        Angular rate (rad/s), > 0.
+
+    Returns
+    -------
+    numpy.ndarray
+        The two eigenvalues (1/s), complex, sorted by real part.
+    """
     p_s, _ = circle_equilibria(body, R, theta)
     k0 = theta / body.I * math.sqrt(max(body.a**2 * R**2 * (body.m**2 * theta**2 + body.c**2)
                                         - body.c_phi**2, 0.0))
@@ -79,7 +137,22 @@ def circle_eigenvalues(body: Body, R: float, theta: float) -> np.ndarray:
 
 
 def circle_rotation_rhs(body: Body, R, theta, p, v_p) -> np.ndarray:
-    """Right side of the corrected (33): returns v_p' (rad/s^2); vectorised over arrays."""
+    """Right side of the corrected (33): returns v_p' (rad/s^2); vectorised over arrays.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    R, theta : array_like
+        Radius (m) and angular rate (rad/s).
+    p, v_p : array_like
+        The rotation error (rad) and its rate (rad/s).
+
+    Returns
+    -------
+    numpy.ndarray
+        v_p' (rad/s^2), of the broadcast shape.
+    """
     p, v_p = np.asarray(p, dtype=float), np.asarray(v_p, dtype=float)
     return (-body.c_phi / body.I * v_p - body.a * body.c * theta * R / body.I * np.sin(p)
             + body.a * body.m * theta**2 * R / body.I * np.cos(p) - body.c_phi * theta / body.I)
@@ -106,7 +179,28 @@ def circle_final_state(body: Body, R, theta, p0=0.0, v0=0.0, t_end: float = 300.
     ``slipping``: p changed by more than a whole turn over the second half of
     the run; otherwise the run is extended, doubling its length, up to ``t_max``
     s, after which the point is ``undecided``. Returns a DataFrame with R, theta,
-    p0, v0, p_end, v_end, t_end (s) and regime."""
+    p0, v0, p_end, v_end, t_end (s) and regime.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    R, theta : array_like
+        Radii (m) and rates (rad/s), > 0, broadcast.
+    p0, v0 : array_like
+        Start (rad, rad/s), broadcast.
+    t_end : float
+        First horizon (s).
+    t_max : float
+        Longest horizon (s).
+    rtol, atol : float
+        Tolerances of ``solve_ivp``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per broadcast point: R, theta, p0, v0, p_end, v_end, t_end (s), regime.
+    """
     R, theta, p0, v0 = _circle_arrays(body, R, theta, p0, v0)
     N = R.size
     ps = np.full(N, np.nan)
@@ -152,6 +246,20 @@ def circle_slipping_coexists(body: Body, R, theta, t_end: float = 400.0) -> np.n
     running periodic orbit exists; if it falls into the stable equilibrium, every
     motion not on the saddle's stable manifold settles. (This is the homoclinic
     bifurcation of the damped driven pendulum, Strogatz 2015, Sec. 8.5.)
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    R, theta : array_like
+        Radii (m) and rates (rad/s), broadcast, R > R_crit.
+    t_end : float
+        Horizon (s) of the branch's integration.
+
+    Returns
+    -------
+    numpy.ndarray
+        One bool per broadcast point.
     """
     R, theta = _circle_arrays(body, R, theta)
     N = R.size
@@ -202,6 +310,22 @@ def homoclinic_miss(body: Body, R: float, theta: float, rtol: float = 1e-10) -> 
     (U(p_u - 2 pi) + U(p_s))/2: trapped too, and never turning if it creeps into a node).
     Returns (U(p_u - 2 pi) - E_end)/A: -p'^2/(2A) < 0 at the next saddle when the branch
     runs on, > 0 when it falls back, zero on the homoclinic connection.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    R : float
+        Radius (m), > R_crit.
+    theta : float
+        Angular rate (rad/s), > 0.
+    rtol : float
+        Relative tolerance of ``solve_ivp``.
+
+    Returns
+    -------
+    float
+        The signed miss (dimensionless): positive where the branch runs on past the next saddle.
     """
     p_s, p_u = circle_equilibria(body, R, theta)
     if p_u < p_s:                              # the saddle just above p_s
@@ -277,6 +401,18 @@ def bistable_window(body: Body, Theta: float) -> tuple[float, float]:
     the last two steps to 1e-10 in k, so to about 1e-10 relative in R (the shooting's
     own error, at ``rtol`` 1e-10, is smaller). The edge is the first sign change
     going outwards from R_crit.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    Theta : float
+        Angular rate (rad/s), > 0.
+
+    Returns
+    -------
+    R_crit, R_edge : float
+        The window's edges (m).
     """
     from scipy.optimize import brentq
 
@@ -310,6 +446,16 @@ def window_closing_rate(body: Body) -> float:
     Theta_close and falls back below. The normalised damping at R_crit,
     sqrt(c_phi/(I Theta_close)), is then the damped pendulum's threshold
     (:func:`torque_pendulum_threshold`) at that k.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+
+    Returns
+    -------
+    float
+        Theta_close (rad/s).
     """
     from scipy.optimize import brentq
 
@@ -333,6 +479,16 @@ def torque_pendulum_threshold(k: float = 1.0 - WINDOW_RESOLUTION) -> float:
     equilibrium iff alpha is below it; as k -> 1 it tends to the classical value, about
     1.19 (Strogatz 2015, Sec. 8.5). Computed apart from (33) and :func:`homoclinic_miss`
     (its own shooting, LSODA, rtol 1e-11), as their independent check.
+
+    Parameters
+    ----------
+    k : float
+        The normalised torque, in (0, 1).
+
+    Returns
+    -------
+    float
+        The threshold damping alpha (dimensionless).
     """
     from scipy.optimize import brentq
 

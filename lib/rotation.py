@@ -76,7 +76,24 @@ def _check_grid(R, Theta):
 def steps_per_period(body: Body, kind: str, R, Theta, h_lambda: float = 0.125) -> np.ndarray:
     """Fixed steps per reference period for each point: a power of two (>= 64)
     such that h Lambda <= ``h_lambda``, where Lambda = A + sqrt(B v_max + C a_max)
-    bounds the moduli of the eigenvalues of the linearised equation (in s)."""
+    bounds the moduli of the eigenvalues of the linearised equation (in s).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    kind : str
+        ``"eight"`` or ``"circle"``.
+    R, Theta : array_like
+        Radii (m) and rates (rad/s), 1-D.
+    h_lambda : float
+        The bound on h Lambda.
+
+    Returns
+    -------
+    numpy.ndarray
+        Steps per period (int), one per point.
+    """
     at, _ = _shape(kind)
     s = np.linspace(0, 2 * np.pi, 721)
     X1, Y1, X2, Y2, _, _ = at(s)
@@ -94,7 +111,32 @@ def reduced_rotation(body: Body, kind: str, R: float, Theta: float, periods: int
     reference periods. Returns (t (s), p (rad)) at every step (and t = 0).
 
     This is the exact closed loop (23), (25)-(26) when the position starts on the
-    reference (the position errors then stay zero)."""
+    reference (the position errors then stay zero).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    kind : str
+        ``"eight"`` or ``"circle"``.
+    R : float
+        Radius (m).
+    Theta : float
+        Rate (rad/s).
+    periods : int
+        Reference periods.
+    steps : int, optional
+        Steps per period (default :func:`steps_per_period`).
+    p0, v0 : float
+        Start (rad, rad/s).
+
+    Returns
+    -------
+    t : numpy.ndarray
+        Times (s).
+    p : numpy.ndarray
+        The rotation error (rad).
+    """
     R_, Th_ = _check_grid(R, Theta)
     n = int(steps or steps_per_period(body, kind, R_, Th_)[0])
     at, winding = _shape(kind)
@@ -172,6 +214,20 @@ def classify_samples(P: np.ndarray, tol: float = 1e-9, dP: np.ndarray | None = N
     ``period`` periods; with the phase derivatives ``dP`` = dp/ds at the same
     samples, the extremes are refined by cubic Hermite interpolation, see
     :func:`sampled_range`).
+
+    Parameters
+    ----------
+    P : numpy.ndarray
+        Samples of p (rad), (L_max + 1, N, n).
+    tol : float
+        Defect tolerance (rad).
+    dP : numpy.ndarray, optional
+        dp/ds at the same samples.
+
+    Returns
+    -------
+    dict
+        Arrays (N,): regime, period, slip (turns per period), defect (rad), range (rad).
     """
     P = np.asarray(P, dtype=float)
     if P.ndim != 3 or P.shape[0] < 2 or P.shape[2] < 1:
@@ -203,7 +259,24 @@ def classify_samples(P: np.ndarray, tol: float = 1e-9, dP: np.ndarray | None = N
 
 def sampled_range(y, cyclic=True, dy=None, h: float = 1.0) -> np.ndarray:
     """max - min of each row of ``y`` (samples at equal phase steps ``h``), the extremes
-    refined as :func:`sampled_extremes` refines them."""
+    refined as :func:`sampled_extremes` refines them.
+
+    Parameters
+    ----------
+    y : array_like
+        Samples, one row per signal.
+    cyclic : bool or array_like
+        Whether each row wraps around.
+    dy : array_like, optional
+        Derivatives per unit phase at the samples.
+    h : float
+        The phase step.
+
+    Returns
+    -------
+    numpy.ndarray
+        max - min per row, in the units of y.
+    """
     lo, hi = sampled_extremes(y, cyclic, dy, h)
     return hi - lo
 
@@ -217,7 +290,24 @@ def sampled_extremes(y, cyclic=True, dy=None, h: float = 1.0) -> tuple[np.ndarra
     intervals beside each extreme sample (error O(h^4)), so that the range is
     that of the continuous signal, not of its sampling. ``cyclic`` (per row) lets
     neighbours wrap around, as for whole periods of a periodic signal;
-    otherwise extremes at the ends are not refined."""
+    otherwise extremes at the ends are not refined.
+
+    Parameters
+    ----------
+    y : array_like
+        Samples, one row per signal.
+    cyclic : bool or array_like
+        Whether each row wraps around.
+    dy : array_like, optional
+        Derivatives per unit phase at the samples.
+    h : float
+        The phase step.
+
+    Returns
+    -------
+    lo, hi : numpy.ndarray
+        Minimum and maximum per row, in the units of y.
+    """
     y = np.atleast_2d(np.asarray(y, dtype=float))
     n = y.shape[1]
     if n < 3:
@@ -281,6 +371,32 @@ def rotation_sweep(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, tol: floa
     Returns a DataFrame, one row per point, in order: R (m), Theta (rad/s), range
     (rad), regime, period (reference periods), slip (turns per period), defect
     (rad, the convergence measure), periods (integrated), steps (per period).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    kind : str
+        ``"eight"`` or ``"circle"``.
+    R, Theta : array_like
+        Radii (m) and rates (rad/s), 1-D, > 0.
+    p0, v0 : float or array_like
+        Start (rad, rad/s).
+    tol : float
+        Defect tolerance (rad).
+    min_periods, max_periods, max_lag : int
+        Periods integrated at least and at most, and the longest lag tried.
+    h_lambda : float
+        Step bound (see :func:`steps_per_period`).
+    steps : int, optional
+        Steps per period.
+    engine : str
+        ``"numba"`` or ``"numpy"``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per point (columns above).
     """
     checks.one_of("kind", kind, ("eight", "circle"))
     checks.instance("body", body, Body)
@@ -337,6 +453,24 @@ def rotation_period_map(body: Body, kind: str, R, Theta, *, steps: int | None = 
     d x(2 pi) / d x(0) (N, 2, 2); phi is the heading (rad) and w = d phi / ds. Its
     attribute ``winding`` is the number of turns the reference heading makes per
     period (0 on the eight, 1 on the circle).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    kind : str
+        ``"eight"`` or ``"circle"``.
+    R, Theta : array_like
+        Radii (m) and rates (rad/s), 1-D, > 0.
+    steps : int, optional
+        Steps per period (>= 1).
+    h_lambda : float
+        Step bound when ``steps`` is not given.
+
+    Returns
+    -------
+    callable
+        x (N, 2) -> (x one period later (N, 2), Jacobian (N, 2, 2)).
     """
     checks.one_of("kind", kind, ("eight", "circle"))
     checks.instance("body", body, Body)
@@ -373,7 +507,34 @@ def rotation_orbit(body: Body, kind: str, R, Theta, *, k: int = 1, slip: int = 0
     ``transient`` periods from p(0) = ``p0`` (rad), dp/dt(0) = ``v0`` (rad/s) (the start
     on the reference by default). ``slip`` is the number of whole turns the heading
     error gains per k periods (0 for a repeating motion). The orbit's ``x`` are the
-    states (phi, w = d phi / ds) at phase s = 0."""
+    states (phi, w = d phi / ds) at phase s = 0.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    kind : str
+        ``"eight"`` or ``"circle"``.
+    R, Theta : array_like
+        Radii (m) and rates (rad/s), 1-D, > 0.
+    k : int
+        Period (reference periods).
+    slip : int
+        Whole turns per k periods.
+    p0, v0 : float or array_like
+        Start (rad, rad/s).
+    transient : int
+        Periods before Newton starts.
+    steps : int, optional
+        Steps per period.
+    tol : float
+        Newton's tolerance (rad).
+
+    Returns
+    -------
+    Orbit
+        The orbits (states x (N, 2), multipliers, convergence).
+    """
     R, Theta = _check_grid(R, Theta)
     step = rotation_period_map(body, kind, R, Theta, steps=steps)
     phi, w = _initial(kind, Theta, np.broadcast_to(np.asarray(p0, float), R.shape),
@@ -408,6 +569,28 @@ def rotation_lyapunov(body: Body, kind: str, R, Theta, *, periods: int = 200, tr
     divided by the period 2 pi / Theta, and its standard error that of the mean (the
     rates of successive periods are treated as independent, which is what makes the
     error small only for long runs).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    kind : str
+        ``"eight"`` or ``"circle"``.
+    R, Theta : array_like
+        Radii (m) and rates (rad/s), 1-D, > 0.
+    periods : int
+        Periods averaged (>= 2).
+    transient : int
+        Periods dropped (>= 0).
+    p0, v0 : float or array_like
+        Start (rad, rad/s).
+    steps : int, optional
+        Steps per period.
+
+    Returns
+    -------
+    RotationLyapunov
+        value and stderr (1/s), one per point.
     """
     periods = checks.integer("periods", periods, minimum=2)
     transient = checks.integer("transient", transient, minimum=0)
