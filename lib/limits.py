@@ -44,7 +44,26 @@ __all__ = [
 def stroboscopic_section(loop: SwitchedLoop, s0, n_transient: int, n_points: int, **kw) -> np.ndarray:
     """Poincaré section of the period-T map: the error state (see :func:`error_state`)
     at t = k T for k = n_transient, ..., n_transient + n_points - 1, T the
-    reference period. Returns an array of shape (n_points, 6)."""
+    reference period. Returns an array of shape (n_points, 6).
+
+    Parameters
+    ----------
+    loop : SwitchedLoop
+        The switched closed loop.
+    s0 : array_like
+        Start state (6,) (m, rad, m/s, rad/s).
+    n_transient : int
+        Periods dropped.
+    n_points : int
+        Section points.
+    **kw
+        Tolerances of :meth:`lib.integrators.switched.SwitchedLoop.integrate`.
+
+    Returns
+    -------
+    numpy.ndarray
+        Error states (n_points, 6).
+    """
     if n_points < 1 or n_transient < 0:
         raise ValueError("need n_points >= 1 and n_transient >= 0")
     T = loop.period
@@ -80,6 +99,22 @@ def classify(period: int, lyapunov: float, stderr: float, *, zero_band: float = 
     not tested on this path): "chaotic"; otherwise "periodic-k" when the section has
     period k; otherwise "quasi-periodic" when the exponent is known to be within the band
     of zero; otherwise "undecided" (the estimate is too noisy to decide).
+
+    Parameters
+    ----------
+    period : int
+        Section period (0: none found).
+    lyapunov : float
+        Largest Lyapunov exponent (1/s).
+    stderr : float
+        Its standard error (1/s).
+    zero_band : float
+        The band of zero (1/s).
+
+    Returns
+    -------
+    str
+        The verdict.
     """
     regime = dv.classify([lyapunov], [stderr], [0.0], band=zero_band, return_tol=1.0, max_period=8)[0][0]
     if regime == "chaotic":
@@ -121,7 +156,36 @@ def section_sweep(body: Body, gains: Gains, ref: Reference, angle_limits, *, for
     """Bifurcation data: the stroboscopic section (:func:`stroboscopic_section`,
     ``n_points`` error states after ``n_transient`` periods) for each angle limit (rad),
     from the paper's initial state unless ``z0``/``dz0`` are given; ``workers``
-    processes share the sweep."""
+    processes share the sweep.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    ref : Circle or Eight
+        The reference.
+    angle_limits : float or array_like
+        beta_max (rad), in (0, pi].
+    force_limit : float, optional
+        F_max (N), > 0.
+    n_transient, n_points : int
+        Periods dropped (>= 0) and section points (>= 1).
+    rtol, atol : float
+        Tolerances, > 0.
+    z0, dz0 : array_like, optional
+        Start, default the paper's Table.
+    workers : int
+        Spawned processes (>= 1).
+    progress : bool, optional
+        A progress bar over the limits (default None: only when run interactively).
+
+    Returns
+    -------
+    list of numpy.ndarray
+        One section (n_points, 6) per angle limit.
+    """
     angles = _check_sweep(body, gains, ref, angle_limits, force_limit, n_transient=n_transient,
                           n_points=n_points, rtol=rtol, atol=atol)
     s0 = _start(z0, dz0)
@@ -432,7 +496,32 @@ def extend_undecided(body: Body, gains: Gains, ref: Reference, frame: pd.DataFra
     log-growth of a separation is bounded, so its mean falls as 1 / horizon, and with
     blocks ``factor`` times longer so does its standard error: a longer horizon resolves a
     zero exponent where a chaotic one stays positive. Returns a copy of ``frame`` with
-    those rows replaced and a column ``horizon`` (periods of section and Lyapunov run)."""
+    those rows replaced and a column ``horizon`` (periods of section and Lyapunov run).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    ref : Circle or Eight
+        The reference.
+    frame : pandas.DataFrame
+        A frame of :func:`limit_verdicts`.
+    factor : int
+        Horizon factor.
+    s0 : array_like, optional
+        The start of the frame's runs.
+    steps_per_period : int
+        Fixed steps per period.
+    **options
+        The options of :func:`limit_verdicts`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The frame, its undecided rows decided again, with a column ``horizon``.
+    """
     o = {**LIMIT_DEFAULTS, **options}
 
     def redo(rows, k):
@@ -447,7 +536,20 @@ def regime_edges(frame: pd.DataFrame, regime: str = "chaotic") -> pd.DataFrame:
     """Where a sweep over the angle limit enters or leaves ``regime``: for each force limit
     of ``frame`` (:func:`limit_verdicts`), the pairs of neighbouring angle limits (rad)
     with ``regime`` on one side only. Columns force_limit, lo, hi, below, above (the
-    regimes at lo and at hi)."""
+    regimes at lo and at hi).
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        A frame of :func:`limit_verdicts`.
+    regime : str
+        The regime.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns force_limit (N), lo, hi (rad), below, above.
+    """
     rows = []
     for cap, g in frame.sort_values("angle_limit").groupby("force_limit", sort=True):
         a, r = g.angle_limit.to_numpy(), g.regime.to_numpy()

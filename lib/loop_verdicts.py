@@ -491,7 +491,18 @@ def _decide(flow: _PeriodFlow, obs: dict, turns, o) -> dict:
 def held(frame: pd.DataFrame) -> np.ndarray:
     """(N,) bool, the book's one definition of "held" (:func:`lib.dynamics.verdicts.held`):
     the closed loop reaches an attracting periodic orbit (verdict ``periodic``), the heading is
-    not lost, and the position is tracked (column ``tracked`` of :func:`closed_loop_verdicts`)."""
+    not lost, and the position is tracked (column ``tracked`` of :func:`closed_loop_verdicts`).
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        A frame of :func:`closed_loop_verdicts`.
+
+    Returns
+    -------
+    numpy.ndarray
+        One bool per row.
+    """
     return dv.held(frame.regime.to_numpy(), frame.lost.to_numpy(), frame.tracked.to_numpy())
 
 

@@ -76,14 +76,40 @@ def run(body: Body, gains: Gains, name: str, R: float, theta: float, n_periods: 
 
 
 def steady_mask(res: SimulationResult, n_periods: float) -> np.ndarray:
-    """Boolean mask of the samples in the last ``n_periods`` reference periods."""
+    """Boolean mask of the samples in the last ``n_periods`` reference periods.
+
+    Parameters
+    ----------
+    res : SimulationResult
+        A run (:func:`lib.simulate.simulate`).
+    n_periods : float
+        Reference periods at the end, > 0.
+
+    Returns
+    -------
+    numpy.ndarray
+        One bool per sample.
+    """
     if n_periods <= 0:
         raise ValueError(f"n_periods must be positive, got {n_periods!r}")
     return res.t >= res.t[-1] - n_periods * res.ref.period - 1e-9
 
 
 def restrict(res: SimulationResult, mask) -> SimulationResult:
-    """The samples of ``res`` selected by the boolean ``mask`` (e.g. :func:`steady_mask`)."""
+    """The samples of ``res`` selected by the boolean ``mask`` (e.g. :func:`steady_mask`).
+
+    Parameters
+    ----------
+    res : SimulationResult
+        A run (:func:`lib.simulate.simulate`).
+    mask : array_like
+        One bool per sample, not all False.
+
+    Returns
+    -------
+    SimulationResult
+        The selected samples.
+    """
     mask = np.asarray(mask, dtype=bool)
     if mask.shape != res.t.shape or not mask.any():
         raise ValueError("mask must be a boolean array like res.t selecting at least one sample")
@@ -94,7 +120,18 @@ def restrict(res: SimulationResult, mask) -> SimulationResult:
 
 def rotation_error_continuous(res: SimulationResult) -> np.ndarray:
     """Rotation error p = phi - phi_d (rad), continuous in time, shifted by a multiple of
-    2 pi so that its final value lies in (-pi, pi]."""
+    2 pi so that its final value lies in (-pi, pi].
+
+    Parameters
+    ----------
+    res : SimulationResult
+        A run (:func:`lib.simulate.simulate`).
+
+    Returns
+    -------
+    numpy.ndarray
+        p (rad) per sample.
+    """
     p = np.unwrap(res.rotation_error())
     shift = 2 * np.pi * np.round((p[-1] - wrap_angle(p[-1])) / (2 * np.pi))
     return p - shift
@@ -102,14 +139,42 @@ def rotation_error_continuous(res: SimulationResult) -> np.ndarray:
 
 def position_deviation_from_eq24(body: Body, gains: Gains, res: SimulationResult) -> float:
     """Largest |e_sim - e_(24)| (m) over x and y, e_(24) the analytic solution of (24)
-    from the simulated initial error."""
+    from the simulated initial error.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    res : SimulationResult
+        A run (:func:`lib.simulate.simulate`).
+
+    Returns
+    -------
+    float
+        The largest deviation (m).
+    """
     exact = error_dynamics_solution(body, gains, res.error[0], res.derror[0], res.t)
     return float(np.abs(res.error[:, :2] - exact[:, :2]).max())
 
 
 def steady_summary(res: SimulationResult, n_periods: float = 2.0) -> dict:
     """Steady-state measures over the last ``n_periods`` periods: range of the rotation
-    error p (rad), largest position error (m) and the range of the force F (N)."""
+    error p (rad), largest position error (m) and the range of the force F (N).
+
+    Parameters
+    ----------
+    res : SimulationResult
+        A run (:func:`lib.simulate.simulate`).
+    n_periods : float
+        Reference periods at the end, > 0.
+
+    Returns
+    -------
+    dict
+        p_min, p_max, p_range (rad), pos_err_max (m), F_min, F_max, F_mean (N).
+    """
     mask = steady_mask(res, n_periods)
     p = rotation_error_continuous(res)[mask]
     e = np.hypot(res.error[mask, 0], res.error[mask, 1])
@@ -135,7 +200,30 @@ def refined_summary(body: Body, gains: Gains, res: SimulationResult, n_periods: 
     the closed loop (:class:`lib.closed_loop.ClosedLoop`, with the ``limits`` and
     ``allocation`` of the run) is integrated again from the sample before it to the sample
     after it, at ``n_fine`` points and rtol = atol = 1e-12, and the extreme refined by the
-    parabola through the finest samples (error of order (h / n_fine)^3)."""
+    parabola through the finest samples (error of order (h / n_fine)^3).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    res : SimulationResult
+        A run (:func:`lib.simulate.simulate`).
+    n_periods : float
+        Reference periods at the end, > 0.
+    limits : Limits, optional
+        The run's limits.
+    allocation : Allocation, optional
+        The run's allocation.
+    n_fine : int
+        Points of each refining run.
+
+    Returns
+    -------
+    dict
+        The keys of :func:`steady_summary`, refined.
+    """
     out = steady_summary(res, n_periods)
     loop = ClosedLoop.of(body, gains, reference_of(res.ref), allocation, limits)
     idx = np.flatnonzero(steady_mask(res, n_periods))
@@ -244,7 +332,24 @@ def _sensitivity_one(args) -> dict:
 
 
 def saturated_intervals(t, F, cap: float, rel: float = 1e-9) -> list[tuple[float, float]]:
-    """Time intervals (s) on which the force sits at its cap, F >= cap (1 - rel)."""
+    """Time intervals (s) on which the force sits at its cap, F >= cap (1 - rel).
+
+    Parameters
+    ----------
+    t : array_like
+        Times (s), 1-D.
+    F : array_like
+        Force (N), as long as t.
+    cap : float
+        The cap (N).
+    rel : float
+        Relative tolerance.
+
+    Returns
+    -------
+    list of tuple
+        (start (s), end (s)) of each interval at the cap.
+    """
     t, F = np.asarray(t, dtype=float), np.asarray(F, dtype=float)
     if t.shape != F.shape or t.ndim != 1:
         raise ValueError("t and F must be 1-D arrays of the same length")
@@ -345,6 +450,20 @@ def circle_rotation_equilibrium(body: Body, R: float, theta: float) -> float:
     bracketing on a grid and :func:`scipy.optimize.brentq`, and returns the one
     where the torque decreases with p (stable). Raises ValueError when no
     equilibrium exists (R below the critical radius, Chapter 5).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    R : float
+        Radius (m).
+    theta : float
+        Angular rate (rad/s).
+
+    Returns
+    -------
+    float
+        p* (rad).
     """
     def g(p):
         return body.a * R * theta * (body.m * theta * math.cos(p) - body.c * math.sin(p)) - body.c_phi * theta

@@ -133,6 +133,32 @@ def closed_loop_batch(body: Body, gains: Gains, kind: str, R, Theta, weights=(1.
     jumps without locating them: its error is then of first order in ``dt`` near each
     switch. Check a result by halving ``dt``; the tests compare runs at dt = 5 ms with the
     adaptive :func:`lib.simulate.simulate` (within 1e-5) and Chapter 6's 40 ms runs with 20 ms.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    kind : str
+        ``"circle"`` or ``"eight"``.
+    R, Theta : float or array_like
+        Radii (m), > 0, and rates (rad/s), non-zero.
+    weights : array_like
+        (w_x, w_y, w_phi) >= 0, not all zero, (3,) or (N, 3).
+    t_end, dt, record_dt : float
+        End time, step and sampling interval (s), > 0.
+    z0, dz0 : array_like, optional
+        Start (m, m, rad; m/s, m/s, rad/s), (3,) or (N, 3).
+    allocation : str
+        ``"least_squares"`` or ``"limited"``.
+    limits : Limits, optional
+        Force and angle limits.
+
+    Returns
+    -------
+    BatchResult
+        The runs, sampled every ``record_dt``.
     """
     limits = _check_loop(body, gains, kind, allocation, limits)
     t_end, dt, record_dt = (checks.number(n, v, positive=True, unit="s")
@@ -169,6 +195,18 @@ def steady_metrics(res: BatchResult, n_periods: float = 2.0) -> pd.DataFrame:
     minus that over the period before, and ``position_held`` True when it is
     below 1 mm (the body does not drift away from the path); ``F_max`` and
     ``F_rms`` (N).
+
+    Parameters
+    ----------
+    res : BatchResult
+        Runs of :func:`closed_loop_batch`.
+    n_periods : float
+        Reference periods at the end.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per run, the columns above.
     """
     out = []
     p, e, F = res.rotation_error, res.position_error, res.F
@@ -195,7 +233,20 @@ def stability_boundary(w_phi, frame: pd.DataFrame) -> dict:
     largest weight before the first change), ``first_lost`` (the weight at it; NaN if every
     weight holds), ``ratio`` (their quotient, the resolution of the grid there), ``changes``
     (how often the verdict flips along the grid: more than 1 means it is not monotone), and
-    ``verdict`` (regime, and "position not tracked" or "heading lost" where so) at ``first_lost``."""
+    ``verdict`` (regime, and "position not tracked" or "heading lost" where so) at ``first_lost``.
+
+    Parameters
+    ----------
+    w_phi : array_like
+        Increasing weights (N,).
+    frame : pandas.DataFrame
+        Their verdicts (:func:`closed_loop_verdicts`).
+
+    Returns
+    -------
+    dict
+        last_held, first_lost, ratio, changes, verdict.
+    """
     w = np.asarray(w_phi, dtype=float)
     if w.ndim != 1 or w.size != len(frame) or w.size < 2 or np.any(np.diff(w) <= 0):
         raise ValueError("w_phi must be an increasing 1-D array with one weight per row of frame")
@@ -271,7 +322,26 @@ class MapComparison:
 def compare_on_map(body: Body, gains: Gains, R, Theta, w_phi: float, **options) -> MapComparison:
     """Classify the paper's law (w_phi = 0, exactly (25)-(26)) and the weighted law (weights
     (1, 1, ``w_phi``)) on the eight at the points (R_i (m), Theta_i (rad/s)), both started on
-    the reference, by one call of :func:`closed_loop_verdicts` (``options`` go there)."""
+    the reference, by one call of :func:`closed_loop_verdicts` (``options`` go there).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    R, Theta : array_like
+        Radii (m) and rates (rad/s).
+    w_phi : float
+        The weight of the weighted law, > 0.
+    **options
+        The options of :func:`closed_loop_verdicts`.
+
+    Returns
+    -------
+    MapComparison
+        Both frames and their counts.
+    """
     w_phi = checks.number("w_phi", w_phi, positive=True)
     R, Theta, _ = _points(R, Theta, (1.0, 1.0, 0.0))
     f = verdict_runs(body, gains, {"paper": dict(kind="eight", R=R, Theta=Theta, weights=(1.0, 1.0, 0.0)),
@@ -287,7 +357,36 @@ def limits_comparison(body: Body, gains: Gains, kind: str, R: float, Theta: floa
     for each named :class:`lib.allocation.Limits` in ``limits``, both runs over ``periods``
     reference periods with RK4 step ``dt`` (s), and :func:`steady_metrics` over the last period
     (sampled every second step).
-    Returns one row per (limits, law): the limits' name, ``law``, and the metrics' columns."""
+    Returns one row per (limits, law): the limits' name, ``law``, and the metrics' columns.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    kind : str
+        ``"circle"`` or ``"eight"``.
+    R : float
+        Radius (m).
+    Theta : float
+        Rate (rad/s).
+    weights : array_like
+        (w_x, w_y, w_phi).
+    limits : dict
+        Name -> :class:`lib.allocation.Limits`.
+    periods : int
+        Reference periods.
+    dt : float
+        RK4 step (s).
+    z0, dz0 : array_like, optional
+        Start.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per (limits, law).
+    """
     if not limits:
         raise ValueError("no limits given")
     if isinstance(periods, bool) or not isinstance(periods, (int, np.integer)) or periods < 2:
@@ -309,7 +408,28 @@ def extend_undecided(body: Body, gains: Gains, run: dict, frame: pd.DataFrame, f
     :func:`verdict_runs`: kind, R, Theta, weights, z0, dz0) again over ``factor`` times as many
     observed periods (and blocks as long): a slowly attracting orbit (|mu| near 1) that the run
     had not yet come within the reach tolerance of is then reached. Returns a copy of ``frame``
-    with those rows replaced and a column ``horizon`` (observed periods)."""
+    with those rows replaced and a column ``horizon`` (observed periods).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    run : dict
+        The run of the frame (:func:`verdict_runs`).
+    frame : pandas.DataFrame
+        Its verdicts.
+    factor : int
+        Horizon factor.
+    **options
+        The options of :func:`closed_loop_verdicts`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The frame, its undecided rows decided again, with a column ``horizon``.
+    """
     if isinstance(factor, bool) or not isinstance(factor, (int, np.integer)) or factor < 2:
         raise ValueError(f"factor must be an integer >= 2, got {factor!r}")
     o = {**LOOP_VERDICT_DEFAULTS, **options}
@@ -334,7 +454,34 @@ def refine_boundary(body: Body, gains: Gains, run: dict, w_phi, frame: pd.DataFr
     grid ``w_phi`` with verdicts ``frame``: ``n`` weights evenly spaced in log between the last
     held and the first lost weight, classified by one :func:`closed_loop_verdicts` call with the
     rest of ``run`` (kind, R, Theta, w_x = w_y = 1, z0, dz0), which narrows the bracket by a
-    factor n + 1 in log. Returns the new boundary, and all weights with their verdicts, sorted."""
+    factor n + 1 in log. Returns the new boundary, and all weights with their verdicts, sorted.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    run : dict
+        kind, R (m), Theta (rad/s), z0, dz0.
+    w_phi : array_like
+        The grid of weights.
+    frame : pandas.DataFrame
+        Its verdicts.
+    n : int
+        New weights.
+    **options
+        The options of :func:`closed_loop_verdicts`.
+
+    Returns
+    -------
+    boundary : dict
+        :func:`stability_boundary` on all weights.
+    w_phi : numpy.ndarray
+        All weights, sorted.
+    frame : pandas.DataFrame
+        Their verdicts.
+    """
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
         raise ValueError(f"n must be a positive integer, got {n!r}")
     b = stability_boundary(w_phi, frame)
