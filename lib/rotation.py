@@ -533,7 +533,7 @@ def rotation_orbit(body: Body, kind: str, R, Theta, *, k: int = 1, slip: int = 0
     Returns
     -------
     Orbit
-        The orbits (states x (N, 2), multipliers, convergence).
+        The orbit points x (N, 2), the Jacobian there, residuals, convergence and iterations.
     """
     R, Theta = _check_grid(R, Theta)
     step = rotation_period_map(body, kind, R, Theta, steps=steps)
@@ -590,7 +590,7 @@ def rotation_lyapunov(body: Body, kind: str, R, Theta, *, periods: int = 200, tr
     Returns
     -------
     RotationLyapunov
-        value and stderr (1/s), one per point.
+        value and stderr (1/s) and the periods averaged, one per point.
     """
     periods = checks.integer("periods", periods, minimum=2)
     transient = checks.integer("transient", transient, minimum=0)

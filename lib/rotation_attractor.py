@@ -82,7 +82,33 @@ def rotation_attractor(body: Body, kind: str, R: float, Theta: float, *, p0: flo
     (same options). On the eight (28) the rotation equation (37) is symmetric and has two
     mirror-image period-1 orbits; which one a start reaches is reported by
     ``states[0, 0]``. Raises ValueError if the run reaches no attracting orbit (the
-    verdict is then chaotic, quasiperiodic or undecided)."""
+    verdict is then chaotic, quasiperiodic or undecided).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    kind : str
+        ``"eight"`` or ``"circle"``.
+    R : float
+        Radius (m).
+    Theta : float
+        Rate (rad/s).
+    p0, v0 : float
+        Start (rad, rad/s).
+    h_lambda : float
+        Step bound.
+    steps : int, optional
+        Steps per period.
+    **options
+        The options of :func:`lib.rotation_verdicts.rotation_verdicts`.
+
+    Returns
+    -------
+    RotationAttractor
+        The verdict, the orbit's period, slip and states, its multipliers, p (rad) sampled
+    over it at times t (s), its range (rad) and Newton's residual.
+    """
     for name, v in (("R", R), ("Theta", Theta), ("p0", p0), ("v0", v0)):
         if isinstance(v, bool) or not np.isscalar(v) or not isinstance(v, (int, float, np.integer, np.floating)):
             raise TypeError(f"{name} must be a real scalar, got {type(v).__name__}")
@@ -175,7 +201,18 @@ class MapSummary:
 
 def map_summary(frame: pd.DataFrame) -> MapSummary:
     """The :class:`MapSummary` of a frame returned by :func:`lib.rotation_verdicts.rotation_verdicts` (or
-    :func:`lib.rotation_verdicts.eight_rotation_sweep`)."""
+    :func:`lib.rotation_verdicts.eight_rotation_sweep`).
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        A frame of verdicts.
+
+    Returns
+    -------
+    MapSummary
+        The counts and ranges the book quotes.
+    """
     need = {"regime", "period", "range", "floquet", "lyapunov", "lyapunov_stderr", "lost", "turns_round", "Theta",
             "periods"}
     if not isinstance(frame, pd.DataFrame) or not need <= set(frame.columns):

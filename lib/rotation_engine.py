@@ -27,7 +27,26 @@ def verdict_steps(body: Body, kind: str, R, Theta, h_lambda: float = 0.125, h_da
     (32) (in the phase s) and A is its damping. The damping only sets how fast a
     transient in w dies out, which the 8th-order scheme follows well beyond h A = 1,
     so this asks for about half the steps of :func:`lib.rotation.steps_per_period` at the same
-    accuracy of the attractor (about 1e-10 rad per period)."""
+    accuracy of the attractor (about 1e-10 rad per period).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    kind : str
+        ``"eight"`` or ``"circle"``.
+    R, Theta : array_like
+        Radii (m) and rates (rad/s).
+    h_lambda : float
+        Bound on h omega.
+    h_damp : float
+        Bound on h A.
+
+    Returns
+    -------
+    numpy.ndarray
+        Steps per period (int), one per point.
+    """
     at, _ = _shape(kind)
     s = np.linspace(0, 2 * np.pi, 721)
     X1, Y1, X2, Y2, _, _ = at(s)

@@ -21,7 +21,20 @@ __all__ = ["coefficients", "rotation_rates", "rotation_rates_dphi", "rotation_ra
 
 
 def coefficients(body: Body, R, Theta):
-    """(A, B, C) of the phase form of (32) for arrays R (m), Theta (rad/s)."""
+    """(A, B, C) of the phase form of (32) for arrays R (m), Theta (rad/s).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    R, Theta : array_like
+        Radii (m) and rates (rad/s).
+
+    Returns
+    -------
+    A, B, C : numpy.ndarray
+        The coefficients of the phase form (dimensionless), broadcast.
+    """
     A = body.c_phi / (body.I * Theta)
     B = body.a * R * body.c / (body.I * Theta)
     C = body.a * R * body.m / body.I
@@ -31,12 +44,42 @@ def coefficients(body: Body, R, Theta):
 def rotation_rates(phi, w, A, B, C, X1, Y1, X2, Y2):
     """(phi', w') of the phase form of (32), with X1 = X', Y1 = Y', X2 = X'', Y2 = Y''
     the unit reference's derivatives at the phase. Pure arithmetic and cos/sin, so
-    numba compiles the same function for the compiled engine."""
+    numba compiles the same function for the compiled engine.
+
+    Parameters
+    ----------
+    phi, w : array_like
+        Heading (rad) and w = d phi / ds.
+    A, B, C : array_like
+        :func:`coefficients`.
+    X1, Y1, X2, Y2 : array_like
+        The unit reference's first and second derivatives at the phase.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (d phi / ds, d w / ds).
+    """
     return w, (B * Y1 + C * Y2) * np.cos(phi) - (B * X1 + C * X2) * np.sin(phi) - A * w
 
 
 def rotation_rates_dphi(phi, B, C, X1, Y1, X2, Y2):
-    """d w' / d phi of :func:`rotation_rates` (d w' / d w = -A), for the variational equation."""
+    """d w' / d phi of :func:`rotation_rates` (d w' / d w = -A), for the variational equation.
+
+    Parameters
+    ----------
+    phi : array_like
+        Heading (rad).
+    B, C : array_like
+        :func:`coefficients`.
+    X1, Y1, X2, Y2 : array_like
+        The unit reference's derivatives at the phase.
+
+    Returns
+    -------
+    numpy.ndarray
+        d w' / d phi.
+    """
     return -(B * Y1 + C * Y2) * np.sin(phi) - (B * X1 + C * X2) * np.cos(phi)
 
 
@@ -44,7 +87,22 @@ def rotation_rates_with_dphi(phi, w, A, B, C, X1, Y1, X2, Y2):
     """(phi', w', d w'/d phi): :func:`rotation_rates` and :func:`rotation_rates_dphi` at
     once, sharing one cos and one sin, for the variational equation of the compiled
     engine. The same operations in the same order, so the values are bit-identical to
-    the two definitions (``tests/test_rotation_verdicts.py`` checks it at random states)."""
+    the two definitions (``tests/test_rotation_verdicts.py`` checks it at random states).
+
+    Parameters
+    ----------
+    phi, w : array_like
+        Heading (rad) and w = d phi / ds.
+    A, B, C : array_like
+        :func:`coefficients`.
+    X1, Y1, X2, Y2 : array_like
+        The unit reference's derivatives at the phase.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (d phi / ds, d w / ds, d w' / d phi).
+    """
     cp, sp = np.cos(phi), np.sin(phi)
     P = B * Y1 + C * Y2
     Q = B * X1 + C * X2

@@ -22,7 +22,22 @@ __all__ = ["error_state", "SwitchedRuns", "switched_runs", "STEPS_PER_PERIOD"]
 def error_state(ref: Reference, t, y) -> np.ndarray:
     """Tracking errors of states ``y`` (n, 6) at times ``t``: columns
     [e_x (m), e_y (m), de_x (m/s), de_y (m/s), p (rad), dp (rad/s)] with
-    e = z_d - z as in (24) and the rotation error p = phi - phi_d wrapped to (-pi, pi]."""
+    e = z_d - z as in (24) and the rotation error p = phi - phi_d wrapped to (-pi, pi].
+
+    Parameters
+    ----------
+    ref : Reference
+        The reference.
+    t : array_like
+        Times (s), (n,).
+    y : array_like
+        States [x, y, phi, xdot, ydot, phidot] (m, m, rad, m/s, m/s, rad/s), (n, 6).
+
+    Returns
+    -------
+    numpy.ndarray
+        The error states (n, 6) in the units above.
+    """
     t = np.asarray(t, dtype=float)
     y = np.atleast_2d(np.asarray(y, dtype=float))
     zd, dzd = ref.z(t), ref.dz(t)
@@ -117,7 +132,41 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
 
     ``ref`` must be the circle or the eight (:mod:`lib.trajectories`). Raises
     ``RuntimeError`` naming the run if its state becomes non-finite or the switching
-    events accumulate (more than 200 in one step)."""
+    events accumulate (more than 200 in one step).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    ref : Circle or Eight
+        The reference.
+    angle_limits : float or array_like
+        beta_max (rad), in (0, pi], one or one per run.
+    force_limits : float or array_like, optional
+        F_max (N), > 0 (inf or None for none), one or one per run.
+    s0 : array_like, optional
+        Start states (m, rad, m/s, rad/s), (6,) or (N, 6).
+    n_periods : int
+        Reference periods (>= 1).
+    lyapunov_from : int, optional
+        Period from which the Lyapunov companion runs.
+    steps_per_period : int
+        Fixed steps per period (>= 16).
+    samples_per_period : int
+        Recorded states per period (divides ``steps_per_period``).
+    d0 : float
+        The companion's initial separation, in (0, 1e-3).
+    k_slide : float
+        The sliding exits' gain.
+
+    Returns
+    -------
+    SwitchedRuns
+        The limits, the sample times, the recorded states and errors, the final modes, the
+    companion's log-growths and the event statistics (crossings, slides, time sliding).
+    """
     from .integrators.switched_compiled import run_periods  # numba compiles on first use: only when asked
 
     _check_parts(body, gains, ref)

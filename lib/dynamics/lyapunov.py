@@ -35,6 +35,30 @@ def largest_lyapunov(flow: Callable, x0, dt: float, n_steps: int, *, d0: float =
     ``difference`` (default a - b), log(d / d0) recorded, and the companion
     pulled back to distance d0 along the separation.
     Returns the mean of log(d/d0)/dt and its standard error.
+
+    Parameters
+    ----------
+    flow : callable
+        (x, t0, t1) -> the state at t1.
+    x0 : array_like or tuple
+        The start (with its extra state, if the flow carries one).
+    dt : float
+        Renormalisation interval (s).
+    n_steps : int
+        Intervals averaged.
+    d0 : float
+        Initial separation (the state's units).
+    n_transient : int
+        Intervals before the companion starts.
+    difference : callable, optional
+        (a, b) -> a - b (e.g. with an angle wrapped).
+    direction : array_like, optional
+        The companion's initial direction.
+
+    Returns
+    -------
+    LyapunovEstimate
+        value (1/s), its standard error and the running estimate.
     """
     if dt <= 0 or n_steps < 2 or d0 <= 0:
         raise ValueError("need dt > 0, n_steps >= 2 and d0 > 0")

@@ -63,7 +63,18 @@ class Orbit:
 
 
 def floquet_multipliers(jacobian) -> np.ndarray:
-    """Eigenvalues of DP^k (shape (..., d, d)), sorted by decreasing modulus."""
+    """Eigenvalues of DP^k (shape (..., d, d)), sorted by decreasing modulus.
+
+    Parameters
+    ----------
+    jacobian : array_like
+        DP^k, shape (..., d, d).
+
+    Returns
+    -------
+    numpy.ndarray
+        The multipliers (complex, dimensionless), (..., d).
+    """
     J = np.asarray(jacobian, dtype=float)
     if J.ndim < 2 or J.shape[-1] != J.shape[-2]:
         raise ValueError(f"jacobian must have shape (..., d, d), got {J.shape}")
@@ -97,7 +108,38 @@ def newton(step: Callable, idx, x0, k, *, turn_axis: int = 0, turns=None, tol: f
     it at least halves) and, below ``tol``, while it is above ``polish`` and still
     halves; at most ``max_iter`` steps. Returns a :class:`NewtonResult`: x (M, d), DP^k
     (M, d, d) at the last iterate, the residual (M,) (max-norm; NaN where a step was not
-    finite), the turns n (M,) and the steps taken (M,)."""
+    finite), the turns n (M,) and the steps taken (M,).
+
+    Parameters
+    ----------
+    step : callable
+        (idx, x, k) -> (P^k(x), DP^k).
+    idx : array_like
+        Rows of the map (M,).
+    x0 : array_like
+        Starting points (M, d).
+    k : int or array_like
+        Periods (one or one per row).
+    turn_axis : int
+        The heading's column.
+    turns : array_like, optional
+        Whole turns per row.
+    tol : float
+        Residual tolerance (the state's units).
+    max_iter : int
+        Iterations.
+    max_step : float
+        Longest step (max-norm).
+    stall_after : int, optional
+        Iterations after which a row goes on only while its residual halves.
+    polish : float, optional
+        Residual below which a row is polished.
+
+    Returns
+    -------
+    NewtonResult
+        The points x, the Jacobian there, the residuals, the turns and the iterations.
+    """
     x = np.array(x0, dtype=float)
     M, d = x.shape
     idx = np.asarray(idx)
@@ -158,6 +200,28 @@ def newton_orbit(step: MapWithJacobian, x0, k: int = 1, shift=0.0, *, tol: float
     cut back to it, which keeps a far start from jumping across the phase
     space. Points whose residual falls to ``tol`` stop; the rest stop after
     ``max_iter`` steps with ``converged`` False. (:func:`newton` on the map less its shift.)
+
+    Parameters
+    ----------
+    step : callable
+        x (N, d) -> (P(x), DP(x)).
+    x0 : array_like
+        Starting guesses (N, d).
+    k : int
+        Period (>= 1).
+    shift : float or array_like
+        Advance per k periods, (d,) or (N, d).
+    tol : float
+        Residual tolerance.
+    max_iter : int
+        Iterations.
+    max_step : float
+        Longest step (max-norm).
+
+    Returns
+    -------
+    Orbit
+        The orbit points x, the Jacobian there, the residuals, convergence and iterations.
     """
     if not isinstance(k, (int, np.integer)) or k < 1:
         raise ValueError(f"period k must be a positive integer, got {k!r}")

@@ -12,7 +12,20 @@ __all__ = ["distinct_points", "section_period", "section_margin"]
 
 def distinct_points(points, tol: float) -> int:
     """Number of clusters of ``points`` (n, d) whose members lie within ``tol`` of
-    the cluster's first point (max-norm); a period-k orbit of the map gives k."""
+    the cluster's first point (max-norm); a period-k orbit of the map gives k.
+
+    Parameters
+    ----------
+    points : array_like
+        Section points (n, d).
+    tol : float
+        Cluster radius (max-norm, the points' units).
+
+    Returns
+    -------
+    int
+        The number of clusters.
+    """
     pts = np.atleast_2d(np.asarray(points, dtype=float))
     if pts.shape[0] == 0:
         raise ValueError("points must not be empty")
@@ -35,7 +48,24 @@ def section_period(points, tol: float, max_period: int = 8) -> tuple[int, bool]:
     spread, and the extrapolated limit is then close to d_n itself; a slow geometric
     approach to an orbit, whose ratio still creeps up towards the slowest
     multiplier, extrapolates to a small fraction of d_n.) (0, False) if neither
-    holds for any k."""
+    holds for any k.
+
+    Parameters
+    ----------
+    points : array_like
+        Section points (n, d), oldest first.
+    tol : float
+        Tolerance (max-norm, the points' units).
+    max_period : int
+        Longest period tried.
+
+    Returns
+    -------
+    k : int
+        The period (0: none found).
+    converging : bool
+        Whether the sequence is still converging to it.
+    """
     pts = np.atleast_2d(np.asarray(points, dtype=float))
     n = pts.shape[0]
     if n < 4:
@@ -57,7 +87,22 @@ def section_margin(points, tol: float, max_period: int = 8) -> float:
     points repeat every k periods; for none found, the smallest distance |P_(j+k) - P_j|
     over the second half at any lag k <= ``max_period``, over ``tol``; NaN for a
     sequence still converging (decided by :func:`section_period`'s extrapolation).
-    A margin of 30 means the verdict would survive errors 30 times the tolerance."""
+    A margin of 30 means the verdict would survive errors 30 times the tolerance.
+
+    Parameters
+    ----------
+    points : array_like
+        Section points (n, d), oldest first.
+    tol : float
+        Tolerance (max-norm).
+    max_period : int
+        Longest period tried.
+
+    Returns
+    -------
+    float
+        The margin (dimensionless), NaN while converging.
+    """
     pts = np.atleast_2d(np.asarray(points, dtype=float))
     k, converging = section_period(pts, tol, max_period)
     if converging:

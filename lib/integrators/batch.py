@@ -53,7 +53,28 @@ Rates = Callable[[float, np.ndarray], np.ndarray]
 def steps(rates: Rates, y0, t0: float, h: float, n_steps: int, tableau: Tableau = RK4) -> Iterator:
     """Yield (t, y) after each of ``n_steps`` steps of size ``h`` from (t0, y0), for
     y' = rates(t, y); y may have any shape (e.g. (N points, d)), rates returns the same.
-    Stage sums are taken term by term in order, zero coefficients skipped."""
+    Stage sums are taken term by term in order, zero coefficients skipped.
+
+    Parameters
+    ----------
+    rates : callable
+        (t, y) -> y'.
+    y0 : array_like
+        Start, any shape.
+    t0 : float
+        Start time.
+    h : float
+        Step.
+    n_steps : int
+        Steps.
+    tableau : Tableau
+        The explicit Runge-Kutta method.
+
+    Yields
+    ------
+    tuple
+        (t, y) after each step.
+    """
     A, b, c = tableau.A, tableau.b, tableau.c
     hA, hb = h * A, h / tableau.b_den
     n_st = len(c)
@@ -80,7 +101,30 @@ def integrate(rates: Rates, y0, t0: float, t_end: float, dt: float, tableau: Tab
     """Integrate from t0 to ``t_end`` with the largest step h <= ``dt`` that divides the
     interval, recording (t, y) at the start, every ``record_every`` steps and at the end.
     A state that becomes non-finite raises ``FloatingPointError`` naming the time and the
-    first point (index along the first axis) affected."""
+    first point (index along the first axis) affected.
+
+    Parameters
+    ----------
+    rates : callable
+        (t, y) -> y'.
+    y0 : array_like
+        Start, any shape.
+    t0, t_end : float
+        Start and end times.
+    dt : float
+        Largest step.
+    tableau : Tableau
+        The explicit Runge-Kutta method.
+    record_every : int
+        Steps between records.
+
+    Returns
+    -------
+    t : numpy.ndarray
+        Recorded times, (n,).
+    y : numpy.ndarray
+        Recorded states, (n,) + y0.shape.
+    """
     n_steps = int(np.ceil((t_end - t0) / dt))
     h = (t_end - t0) / n_steps
     ts, ys = [t0], [np.array(y0, dtype=np.result_type(np.asarray(y0), float))]

@@ -58,6 +58,28 @@ def integrate(rhs: Callable, s0, t_end: float, t_eval, integration: Integration,
     A state whose magnitude exceeds ``integration.blowup`` raises
     :class:`SimulationError` naming the time and the largest variable (``names``);
     so does a failure of the solver. Returns (t, s) with s of shape (n, len(s0)).
+
+    Parameters
+    ----------
+    rhs : callable
+        (t, s) -> s'.
+    s0 : array_like
+        Start state.
+    t_end : float
+        End time (s).
+    t_eval : array_like
+        Output times (s).
+    integration : Integration
+        Method, tolerances, blow-up bound.
+    names : tuple of str
+        The state's variable names, for messages.
+
+    Returns
+    -------
+    t : numpy.ndarray
+        Times (s), (n,).
+    s : numpy.ndarray
+        States, (n, len(s0)).
     """
     def blew_up(t, s):
         return integration.blowup - np.max(np.abs(s))
