@@ -47,9 +47,10 @@ benchmark: $(STAMP)
 clean:
 	rm -rf _build
 
-# Mutation testing of the core modules with mutmut, by hand (not in CI), niced: about 25 min
-# on 2 cores for all but allocation, about 40 min for allocation alone (MODULES=allocation).
-# Appends the score and the surviving mutants to mutation/REPORT.md.
-# MODULES="angles params" limits it to some of the seven.
+# Mutation testing of the core modules and of the verdict procedure with mutmut, by hand (not in
+# CI), niced: about 25 min on 2 cores for the six core modules other than allocation, about 40 min
+# for allocation alone (MODULES=allocation), about 4 min for the verdict procedure
+# (MODULES=dynamics.verdicts). Appends the score and the surviving mutants to mutation/REPORT.md.
+# MODULES="angles params" limits it to some of them.
 mutation: $(STAMP)
 	$(BIN)/python mutation/run.py $(MODULES)
