@@ -91,7 +91,32 @@ def lag_candidates(hist, max_period: int, tol: float, *, turn_axis: int, turns=T
     heading (column ``turn_axis``) up to n whole turns where ``turns`` ((N,) bool, or
     one bool) allows it; a single chance return is not enough, so ``ends`` >= 2.
     Returns (ok, n, defect), each (max_period, N), row k - 1 for lag k: ok = defect <=
-    ``tol``, n the whole turns between the last state and the one k periods before."""
+    ``tol``, n the whole turns between the last state and the one k periods before.
+
+    Parameters
+    ----------
+    hist : array_like
+        Section states (L, N, d), oldest first.
+    max_period : int
+        Longest lag.
+    tol : float
+        Tolerance (max-norm, the state's units).
+    turn_axis : int
+        The heading's column.
+    turns : bool or array_like
+        Whether whole turns are allowed, one or per run.
+    ends : int
+        States compared at each lag (>= 2).
+
+    Returns
+    -------
+    ok : numpy.ndarray
+        (max_period, N) bool.
+    n : numpy.ndarray
+        Whole turns (max_period, N).
+    defect : numpy.ndarray
+        The largest distance (max_period, N).
+    """
     hist = np.asarray(hist, dtype=float)
     L, N, _ = hist.shape
     allow = np.broadcast_to(np.asarray(turns, dtype=bool), (N,))
@@ -111,7 +136,28 @@ def lag_candidates(hist, max_period: int, tol: float, *, turn_axis: int, turns=T
 
 def difference_jacobian(pmap: PeriodMap, idx, x, k, h: float) -> tuple[np.ndarray, np.ndarray]:
     """P^k(x) (M, d) and DP^k (M, d, d) by forward differences of step ``h``: the d
-    companions x + h e_j of every row go through ``pmap.advance`` in one batch with it."""
+    companions x + h e_j of every row go through ``pmap.advance`` in one batch with it.
+
+    Parameters
+    ----------
+    pmap : PeriodMap
+        The period map.
+    idx : array_like
+        Rows (M,).
+    x : array_like
+        States (M, d).
+    k : int or array_like
+        Periods.
+    h : float
+        Difference step (the state's units).
+
+    Returns
+    -------
+    y : numpy.ndarray
+        P^k(x), (M, d).
+    J : numpy.ndarray
+        DP^k by differences, (M, d, d).
+    """
     x = np.asarray(x, dtype=float)
     M, d = x.shape
     k = np.broadcast_to(np.asarray(k, dtype=int), (M,))
@@ -126,7 +172,28 @@ def least_period(x, pts, k, n, *, turn_axis: int, turns=True, tol: float):
     is one too. ``x`` (M, d) the orbit points, ``pts`` (K, M, d) their images P^j(x),
     j = 1..K (NaN past a row's own k), ``k`` and ``n`` (M,) the lag and turns Newton
     used. Returns (k_min, n_min): the smallest divisor d of k with P^d(x) = x + 2 pi n'
-    e_heading within ``tol``, and its turns n'."""
+    e_heading within ``tol``, and its turns n'.
+
+    Parameters
+    ----------
+    x : array_like
+        Orbit points (M, d).
+    pts : array_like
+        Their images (K, M, d).
+    k, n : array_like
+        Lag and turns (M,).
+    turn_axis : int
+        The heading's column.
+    turns : bool or array_like
+        Whether whole turns are allowed.
+    tol : float
+        Tolerance.
+
+    Returns
+    -------
+    k_min, n_min : numpy.ndarray
+        The least period and its turns (M,).
+    """
     k = np.asarray(k, dtype=int)
     kmin, nmin = k.copy(), np.asarray(n, dtype=int).copy()
     allow = np.broadcast_to(np.asarray(turns, dtype=bool), (k.size,))
@@ -142,7 +209,26 @@ def least_period(x, pts, k, n, *, turn_axis: int, turns=True, tol: float):
 def distance_to_orbit(state, pts, *, turn_axis: int, turns=True):
     """Distance (max-norm; the heading modulo 2 pi where ``turns`` allows it) from states
     (M, d) to the nearest of the orbit points ``pts`` (K, M, d) (NaN rows ignored), and
-    the index of that point. Returns (distance (M,), index (M,))."""
+    the index of that point. Returns (distance (M,), index (M,)).
+
+    Parameters
+    ----------
+    state : array_like
+        States (M, d).
+    pts : array_like
+        Orbit points (K, M, d).
+    turn_axis : int
+        The heading's column.
+    turns : bool or array_like
+        Whether the heading counts modulo 2 pi.
+
+    Returns
+    -------
+    distance : numpy.ndarray
+        (M,), the state's units.
+    index : numpy.ndarray
+        The nearest point's index (M,).
+    """
     dd = np.asarray(state, dtype=float)[None] - pts
     allow = np.broadcast_to(np.asarray(turns, dtype=bool), (dd.shape[1],))
     dd[..., turn_axis] = np.where(allow, wrap_angle(dd[..., turn_axis]), dd[..., turn_axis])
@@ -157,7 +243,24 @@ def reached(d_now, d_then, rho, periods_ratio, *, tol: float, floor: float) -> n
     is below ``floor``, or below ``tol`` and shrinking since ``d_then`` (an earlier
     distance, ``periods_ratio`` = periods between / k periods of the orbit earlier) no
     slower than the slowest multiplier ``rho`` (= |mu_1|) allows:
-    d_now <= 3 d_then rho^periods_ratio + floor."""
+    d_now <= 3 d_then rho^periods_ratio + floor.
+
+    Parameters
+    ----------
+    d_now, d_then : array_like
+        Distances to the orbit now and earlier (N,).
+    rho : array_like
+        |mu_1| (N,).
+    periods_ratio : float or array_like
+        Periods between the two distances over k.
+    tol, floor : float
+        The reach tolerance and floor.
+
+    Returns
+    -------
+    numpy.ndarray
+        (N,) bool.
+    """
     d_now, d_then = np.asarray(d_now, dtype=float), np.asarray(d_then, dtype=float)
     shrink = (d_now < d_then) & (d_now <= 3.0 * d_then * np.asarray(rho) ** periods_ratio + floor)
     return (d_now <= floor) | ((d_now <= tol) & shrink)
@@ -166,7 +269,20 @@ def reached(d_now, d_then, rho, periods_ratio, *, tol: float, floor: float) -> n
 def block_statistics(per_period, block: int) -> tuple[np.ndarray, np.ndarray]:
     """Mean and batch-means standard error of a per-period series (N, L) over its last
     complete blocks of ``block`` periods: the standard error is that of the block means,
-    so that correlated periods do not shrink it. Returns (mean (N,), stderr (N,))."""
+    so that correlated periods do not shrink it. Returns (mean (N,), stderr (N,)).
+
+    Parameters
+    ----------
+    per_period : array_like
+        A series per period (N, L).
+    block : int
+        Periods per block.
+
+    Returns
+    -------
+    mean, stderr : numpy.ndarray
+        (N,) each, in the series' units.
+    """
     v = np.asarray(per_period, dtype=float)
     N, L = v.shape
     nb = L // block
@@ -176,7 +292,18 @@ def block_statistics(per_period, block: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def batch_means(block_means) -> tuple[np.ndarray, np.ndarray]:
-    """Mean and standard error of the means of consecutive blocks (N, nb), nb >= 2."""
+    """Mean and standard error of the means of consecutive blocks (N, nb), nb >= 2.
+
+    Parameters
+    ----------
+    block_means : array_like
+        Block means (N, nb), nb >= 2.
+
+    Returns
+    -------
+    mean, stderr : numpy.ndarray
+        (N,) each.
+    """
     m = np.asarray(block_means, dtype=float)
     return m.mean(axis=1), m.std(axis=1, ddof=1) / np.sqrt(m.shape[1])
 
@@ -184,7 +311,22 @@ def batch_means(block_means) -> tuple[np.ndarray, np.ndarray]:
 def drift_statistics(at_block_ends, periods_per_block: float, unit: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """Drift per period of a quantity sampled at block ends (N, m + 1), in ``unit``
     (2 pi: turns of an angle), with the standard error of its m block increments.
-    Returns (drift (N,), stderr (N,))."""
+    Returns (drift (N,), stderr (N,)).
+
+    Parameters
+    ----------
+    at_block_ends : array_like
+        The quantity at block ends (N, m + 1).
+    periods_per_block : float
+        Periods per block.
+    unit : float
+        The unit of the result (2 pi: turns).
+
+    Returns
+    -------
+    drift, stderr : numpy.ndarray
+        Per period, (N,) each.
+    """
     inc = np.diff(np.asarray(at_block_ends, dtype=float), axis=1) / (unit * periods_per_block)
     return inc.mean(axis=1), inc.std(axis=1, ddof=1) / np.sqrt(inc.shape[1])
 
@@ -198,7 +340,22 @@ def section_returns(sec: np.ndarray, leave: float = 0.25, angles=(0,)) -> np.nda
     closed invariant curve filled by a quasi-periodic motion, which comes back near
     every point; at least ``leave`` for a motion that moves away for good (inf if it
     never moves that far), e.g. a slow approach to an orbit along a line, which a zero
-    Lyapunov exponent alone would not tell apart. Returns (N,)."""
+    Lyapunov exponent alone would not tell apart. Returns (N,).
+
+    Parameters
+    ----------
+    sec : numpy.ndarray
+        Section states (L, N, d).
+    leave : float
+        How far (in diameters) a run must first move away.
+    angles : tuple of int
+        Columns compared modulo 2 pi.
+
+    Returns
+    -------
+    numpy.ndarray
+        The closest return over the diameter (dimensionless), (N,).
+    """
     sec = np.array(sec, dtype=float)
     if sec.ndim != 3 or sec.shape[2] < 1:
         raise ValueError(f"sec must have shape (L, N, d), got {sec.shape}")
@@ -227,7 +384,28 @@ def classify(lam_T, se_T, returns, *, band: float, return_tol: float, max_period
     :func:`section_returns` (N,): ``chaotic`` when lambda T > max(``sigmas`` SE T,
     ``band``); ``quasiperiodic`` when |lambda T| <= band, SE T <= band / 3 and the
     section returns within ``return_tol``; else ``undecided``, with the reason.
-    Returns (regime (N,) object, reason (N,) object)."""
+    Returns (regime (N,) object, reason (N,) object).
+
+    Parameters
+    ----------
+    lam_T, se_T : array_like
+        lambda T and its standard error (dimensionless, per period), (N,).
+    returns : array_like
+        :func:`section_returns` (N,).
+    band : float
+        The band of zero.
+    return_tol : float
+        Tolerance on the section's return.
+    max_period : int
+        Longest period tried (for the reasons).
+    sigmas : float
+        Standard errors for "chaotic".
+
+    Returns
+    -------
+    regime, reason : numpy.ndarray
+        (N,) object arrays.
+    """
     lam, se = np.asarray(lam_T, dtype=float), np.asarray(se_T, dtype=float)
     chaotic = lam > np.maximum(sigmas * se, band)
     zero = ~chaotic & (np.abs(lam) <= band) & (se <= band / 3)
@@ -244,12 +422,44 @@ def classify(lam_T, se_T, returns, *, band: float, return_tol: float, max_period
 def held(regime, lost, tracked=True) -> np.ndarray:
     """The book's one definition of "held": the run reaches an attracting ``periodic`` orbit,
     its heading is not ``lost``, and, where the flow tracks a position, the position is
-    ``tracked`` (within the flow's stated tolerance). Returns (N,) bool."""
+    ``tracked`` (within the flow's stated tolerance). Returns (N,) bool.
+
+    Parameters
+    ----------
+    regime : array_like
+        Verdicts (N,).
+    lost : array_like
+        Heading lost (N,) bool.
+    tracked : bool or array_like
+        Position tracked.
+
+    Returns
+    -------
+    numpy.ndarray
+        (N,) bool.
+    """
     return (np.asarray(regime) == "periodic") & ~np.asarray(lost, dtype=bool) & np.asarray(tracked, dtype=bool)
 
 
 def orbit_points(pmap: PeriodMap, idx, x, k) -> np.ndarray:
-    """P^j(x) for j = 1, ..., K = max k (K, M, d), NaN past each row's own k."""
+    """P^j(x) for j = 1, ..., K = max k (K, M, d), NaN past each row's own k.
+
+    Parameters
+    ----------
+    pmap : PeriodMap
+        The period map.
+    idx : array_like
+        Rows (M,).
+    x : array_like
+        Orbit points (M, d).
+    k : array_like
+        Periods (M,).
+
+    Returns
+    -------
+    numpy.ndarray
+        (K, M, d).
+    """
     k = np.broadcast_to(np.asarray(k, dtype=int), (len(idx),))
     K = int(k.max())
     pts = np.full((K,) + np.shape(x), np.nan)
@@ -285,7 +495,39 @@ def find_orbits(step: Callable, pmap: PeriodMap, idx, hist, *, max_period: int, 
     (the orbit point Newton found), mult (N, d) multipliers, residual, distance (of the
     last state to the orbit), near (N, d) the orbit point nearest to the last state, and
     status ("" no candidate, "not converged", "not attracting", "not reached", "found")
-    with floquet (largest |multiplier| of the last attempt)."""
+    with floquet (largest |multiplier| of the last attempt).
+
+    Parameters
+    ----------
+    step : callable
+        (idx, x, k) -> (P^k(x), DP^k).
+    pmap : PeriodMap
+        The period map.
+    idx : array_like
+        Rows (N,).
+    hist : array_like
+        Section states (L, N, d).
+    max_period : int
+        Longest period.
+    candidate_tol, newton_tol, reach_tol, reach_floor : float
+        Tolerances (the state's units).
+    newton_options : dict
+        Keywords of :func:`lib.dynamics.orbits.newton`.
+    turns : bool or array_like
+        Whether whole turns are allowed.
+    fixed_turns : bool
+        Keep the candidate's turns.
+    ends : int
+        States compared per lag.
+    tried : array_like, optional
+        The lag-k defect at which Newton last ran, (max_period, N), updated in place.
+
+    Returns
+    -------
+    dict
+        (N,) arrays: found, k, n, lag, rho, x, mult, residual, distance, near, status,
+    floquet (see above).
+    """
     hist = np.asarray(hist, dtype=float)
     L, N, d = hist.shape
     ax = pmap.turn_axis
@@ -341,7 +583,24 @@ def find_orbits(step: Callable, pmap: PeriodMap, idx, hist, *, max_period: int, 
 def redecide_undecided(frame, horizon: int, factor: int, redo: Callable):
     """A copy of a verdict frame (one row per run, column ``regime``) whose ``undecided`` rows
     are decided again by ``redo(rows, factor)`` (a frame for those rows, over ``factor`` times
-    the ``horizon`` in periods), with a column ``horizon``: the periods each row was observed."""
+    the ``horizon`` in periods), with a column ``horizon``: the periods each row was observed.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        A verdict frame.
+    horizon : int
+        Its periods observed.
+    factor : int
+        Horizon factor.
+    redo : callable
+        (rows, factor) -> the frame of those rows.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The frame with a column ``horizon``.
+    """
     out = frame.copy()
     out["horizon"] = horizon
     todo = np.flatnonzero((frame.regime == "undecided").to_numpy())
@@ -356,7 +615,18 @@ def redecide_undecided(frame, horizon: int, factor: int, redo: Callable):
 
 def orbit_regime(turns) -> np.ndarray:
     """``periodic`` for an attracting orbit reached with n = 0 turns per k periods,
-    ``slipping`` for n != 0."""
+    ``slipping`` for n != 0.
+
+    Parameters
+    ----------
+    turns : array_like
+        Whole turns per k periods (N,).
+
+    Returns
+    -------
+    numpy.ndarray
+        (N,) object array of verdicts.
+    """
     return np.where(np.asarray(turns) == 0, "periodic", "slipping").astype(object)
 
 
@@ -366,7 +636,24 @@ def heading_lost(orbit, turns, drift, drift_se, *, slip_band: float) -> np.ndarr
     slips (``turns`` != 0 per k periods); without one when the heading's net drift (turns per
     period) differs from zero by more than 3 standard errors plus ``slip_band``. A heading
     that swings over more than a turn and comes back is not lost by this definition
-    (:func:`turns_round` counts it). Returns (N,) bool."""
+    (:func:`turns_round` counts it). Returns (N,) bool.
+
+    Parameters
+    ----------
+    orbit : array_like
+        Orbit reached (N,) bool.
+    turns : array_like
+        Its turns (N,).
+    drift, drift_se : array_like
+        Drift (turns per period) and its standard error (N,).
+    slip_band : float
+        The band (turns per period).
+
+    Returns
+    -------
+    numpy.ndarray
+        (N,) bool.
+    """
     orbit = np.asarray(orbit, dtype=bool)
     drifting = np.abs(np.asarray(drift, dtype=float)) > SIGMAS * np.asarray(drift_se, dtype=float) + slip_band
     return np.where(orbit, np.asarray(turns) != 0, drifting)
@@ -375,7 +662,18 @@ def heading_lost(orbit, turns, drift, drift_se, *, slip_band: float) -> np.ndarr
 def turns_round(p_range) -> np.ndarray:
     """The other reading of "lost", reported beside it: the heading error ranges over more
     than a full turn (``p_range`` > 2 pi rad), over the orbit or the observed run, whether
-    or not it comes back. Returns (N,) bool."""
+    or not it comes back. Returns (N,) bool.
+
+    Parameters
+    ----------
+    p_range : array_like
+        Range of the heading error (rad).
+
+    Returns
+    -------
+    numpy.ndarray
+        bool, of the shape of p_range.
+    """
     return np.asarray(p_range, dtype=float) > TWO_PI
 
 
@@ -385,7 +683,30 @@ def enclosed_orbit(step: Callable, idx, sec, *, turn_axis: int, newton_tol: floa
     the heading by its circular mean. A zero exponent and a closed section mean a torus
     only if the orbit inside repels (or none is found); an attracting one inside means a
     slow spiral onto it. Returns (attracting (M,) bool, largest |multiplier| (M,), NaN
-    where Newton did not converge)."""
+    where Newton did not converge).
+
+    Parameters
+    ----------
+    step : callable
+        (idx, x, k) -> (P^k(x), DP^k).
+    idx : array_like
+        Rows (M,).
+    sec : array_like
+        Section states (L, M, d).
+    turn_axis : int
+        The heading's column.
+    newton_tol : float
+        Tolerance.
+    newton_options : dict
+        Keywords of :func:`lib.dynamics.orbits.newton`.
+
+    Returns
+    -------
+    attracting : numpy.ndarray
+        (M,) bool.
+    largest : numpy.ndarray
+        The largest |multiplier| (M,), NaN where Newton did not converge.
+    """
     sec = np.asarray(sec, dtype=float)
     x0 = sec.mean(axis=0)
     x0[:, turn_axis] = np.angle(np.exp(1j * sec[:, :, turn_axis]).mean(axis=0))
