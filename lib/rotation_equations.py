@@ -80,7 +80,13 @@ def derive_rotation_equation() -> RotationEquation:
 
 
 def printed_eq33() -> sp.Expr:
-    """v_p' exactly as printed in (33): its cos p term carries the wrong sign."""
+    """v_p' exactly as printed in (33): its cos p term carries the wrong sign.
+
+    Returns
+    -------
+    sympy.Expr
+        v_p' as printed (rad/s^2).
+    """
     eq = derive_rotation_equation()
     s = eq.params
     m, I, a, c, cphi, R, Th = (s[k] for k in ("m", "I", "a", "c", "c_phi", "R", "Theta"))
@@ -106,7 +112,18 @@ def derive_eight_equation() -> tuple[sp.Symbol, sp.Expr, dict]:
 
 def printed_eq37(misplaced: bool = True) -> sp.Expr:
     """Right side of (37) as printed (``misplaced=True``: the closing bracket puts
-    sin phi on both terms) or with the bracket where it belongs."""
+    sin phi on both terms) or with the bracket where it belongs.
+
+    Parameters
+    ----------
+    misplaced : bool
+        Keep the misplaced bracket.
+
+    Returns
+    -------
+    sympy.Expr
+        The right side (rad/s^2).
+    """
     phi, _, s = derive_eight_equation()
     m, a, c, R, Th, t = (s[k] for k in ("m", "a", "c", "R", "Theta", "t"))
     A = c * sp.cos(Th * t) - m * Th * sp.sin(Th * t)
@@ -118,7 +135,18 @@ def printed_eq37(misplaced: bool = True) -> sp.Expr:
 
 def corrected_p0(k: int):
     """Corrected closed form of the equilibria of (33), symbolic:
-    p0^(k) = k pi + arctan(m Theta / c) - arcsin((-1)^k c_phi / (a R sqrt(m^2 Theta^2 + c^2)))."""
+    p0^(k) = k pi + arctan(m Theta / c) - arcsin((-1)^k c_phi / (a R sqrt(m^2 Theta^2 + c^2))).
+
+    Parameters
+    ----------
+    k : int
+        The branch.
+
+    Returns
+    -------
+    sympy.Expr
+        p0^(k) (rad).
+    """
     s = derive_rotation_equation().params
     m, a, c, cphi, R, Th = (s[n] for n in ("m", "a", "c", "c_phi", "R", "Theta"))
     return k * sp.pi + sp.atan(m * Th / c) - sp.asin((-1) ** k * cphi / (a * R * sp.sqrt(m**2 * Th**2 + c**2)))
@@ -126,7 +154,20 @@ def corrected_p0(k: int):
 
 def printed_p0(k: int, garbled: bool = True):
     """The printed p0^(k) = k pi - arctan(m Theta/c) - arcsin(c_phi / (a c R cos(k pi) sqrt(m^2 Theta^2/(c+1)))).
-    With ``garbled=False`` the square root reads sqrt(m^2 Theta^2 / c^2 + 1), presumably what was meant."""
+    With ``garbled=False`` the square root reads sqrt(m^2 Theta^2 / c^2 + 1), presumably what was meant.
+
+    Parameters
+    ----------
+    k : int
+        The branch.
+    garbled : bool
+        Keep the printed square root.
+
+    Returns
+    -------
+    sympy.Expr
+        p0^(k) as printed (rad).
+    """
     s = derive_rotation_equation().params
     m, a, c, cphi, R, Th = (s[n] for n in ("m", "a", "c", "c_phi", "R", "Theta"))
     root = sp.sqrt(m**2 * Th**2 / (c + 1)) if garbled else sp.sqrt(m**2 * Th**2 / c**2 + 1)

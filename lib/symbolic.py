@@ -26,7 +26,13 @@ __all__ = [
 
 
 def parameter_symbols() -> dict[str, sp.Symbol]:
-    """Positive sympy symbols for the body parameters m, I_C, a, c, c_phi."""
+    """Positive sympy symbols for the body parameters m, I_C, a, c, c_phi.
+
+    Returns
+    -------
+    dict
+        Name -> sympy Symbol (m in kg, I_C in kg m^2, a in m, c in N s/m, c_phi in N m s).
+    """
     return dict(
         m=sp.Symbol("m", positive=True),
         I=sp.Symbol("I_C", positive=True),
@@ -121,6 +127,16 @@ def printed_drift(model: SymbolicModel | None = None) -> sp.Matrix:
 
     Its fifth row reads -c/m v2 + v1 omega; the derivation gives -v1 omega
     (see :func:`derive_body_frame` and the errata).
+
+    Parameters
+    ----------
+    model : SymbolicModel, optional
+        The derived model (default :func:`derive_body_frame`).
+
+    Returns
+    -------
+    sympy.Matrix
+        f as printed, 6 x 1.
     """
     model = model or derive_body_frame()
     X, Y, PHI, V1, V2, W = model.q
@@ -227,6 +243,22 @@ def evaluate_bracket(expr: Bracket, fields: Mapping[str, sp.MatrixBase], q,
 
     ``fields`` maps names to sympy columns (e.g. :func:`model_fields`);
     ``cache`` (a dict) may be shared between calls to reuse inner brackets.
+
+    Parameters
+    ----------
+    expr : Bracket
+        A field name or a pair.
+    fields : mapping
+        Name -> sympy column.
+    q : sequence of sympy.Symbol
+        The coordinates.
+    cache : dict, optional
+        Shared between calls.
+
+    Returns
+    -------
+    sympy.Matrix
+        The bracket's field, n x 1.
     """
     _check_bracket(expr)
     cache = {} if cache is None else cache
@@ -244,7 +276,18 @@ def evaluate_bracket(expr: Bracket, fields: Mapping[str, sp.MatrixBase], q,
 
 
 def bracket_latex(expr: Bracket) -> str:
-    """LaTeX of a bracket expression: ``("g1", ("f", "g2"))`` -> ``[g_1, [f, g_2]]``."""
+    """LaTeX of a bracket expression: ``("g1", ("f", "g2"))`` -> ``[g_1, [f, g_2]]``.
+
+    Parameters
+    ----------
+    expr : Bracket
+        A field name or a pair.
+
+    Returns
+    -------
+    str
+        LaTeX.
+    """
     _check_bracket(expr)
     if isinstance(expr, str):
         name = expr.rstrip("0123456789")
@@ -254,7 +297,18 @@ def bracket_latex(expr: Bracket) -> str:
 
 
 def bracket_degree(expr: Bracket) -> Counter:
-    """How many times each field enters the bracket (Sussmann's degrees delta^i)."""
+    """How many times each field enters the bracket (Sussmann's degrees delta^i).
+
+    Parameters
+    ----------
+    expr : Bracket
+        A field name or a pair.
+
+    Returns
+    -------
+    collections.Counter
+        Field name -> degree.
+    """
     _check_bracket(expr)
     if isinstance(expr, str):
         return Counter({expr: 1})
@@ -267,6 +321,22 @@ def accessibility_matrix(fields: Mapping[str, sp.MatrixBase], brackets: Sequence
 
     Its rank at a state is the dimension of the span of those brackets there;
     rank n everywhere proves the Lie algebra rank condition (Definition 4).
+
+    Parameters
+    ----------
+    fields : mapping
+        Name -> sympy column.
+    brackets : sequence of Bracket
+        The columns.
+    q : sequence of sympy.Symbol
+        The coordinates.
+    cache : dict, optional
+        Shared between calls.
+
+    Returns
+    -------
+    sympy.Matrix
+        C, n x len(brackets).
     """
     if len(brackets) == 0:
         raise ValueError("brackets is empty")
@@ -283,7 +353,20 @@ def _symbols_only():
 
 def model_fields(model: SymbolicModel | None = None, *, printed: bool = False) -> dict[str, sp.Matrix]:
     """``{"f": f, "g1": g1, "g2": g2}`` of eqs. (6), (9), (10); ``printed=True``
-    uses the drift as printed in (6) instead of the derived one."""
+    uses the drift as printed in (6) instead of the derived one.
+
+    Parameters
+    ----------
+    model : SymbolicModel, optional
+        The derived model (default :func:`derive_body_frame`).
+    printed : bool
+        Use the drift as printed in (6).
+
+    Returns
+    -------
+    dict
+        ``{"f": f, "g1": g1, "g2": g2}``, sympy columns 6 x 1.
+    """
     model = model or derive_body_frame()
     f = printed_drift(model) if printed else model.f
     return {"f": f, "g1": model.g1, "g2": model.g2}
@@ -293,6 +376,16 @@ def printed_brackets(model: SymbolicModel | None = None) -> dict[Bracket, sp.Mat
     """The three brackets exactly as printed under eq. (21) of the paper.
 
     (The fifth entry of [f, g2] is printed with ``I`` for ``I_C``.)
+
+    Parameters
+    ----------
+    model : SymbolicModel, optional
+        The derived model (default :func:`derive_body_frame`).
+
+    Returns
+    -------
+    dict
+        Bracket -> sympy column as printed.
     """
     model = model or _symbols_only()
     _, _, PHI, V1, V2, W = model.q
@@ -320,6 +413,17 @@ def compare_printed_brackets(model: SymbolicModel | None = None) -> list[dict]:
     ``"drift typo"`` (wrong, but exactly what the printed drift gives) or
     ``"independent"`` (wrong even with the printed drift). ``"opposite sign
     convention"`` flags entries equal to the bracket [g, f] of the printed drift.
+
+    Parameters
+    ----------
+    model : SymbolicModel, optional
+        The derived model (default :func:`derive_body_frame`).
+
+    Returns
+    -------
+    list of dict
+        One per entry: bracket, row, key, printed, derived, printed_drift, verdict,
+    opposite_convention.
     """
     model = model or derive_body_frame()
     true_fields, printed_fields = model_fields(model), model_fields(model, printed=True)
@@ -346,7 +450,18 @@ RANK_BRACKETS = ["f", "g1", "g2", ("f", "g1"), ("f", "g2"), ("g1", ("f", "g2"))]
 def rank_determinants(model: SymbolicModel | None = None) -> dict[str, sp.Expr]:
     """det C of the distribution (21), factored: ``"printed"`` with the drift (6) and the
     three bracket columns exactly as printed under (21), ``"derived"`` with every column
-    computed from the derived model."""
+    computed from the derived model.
+
+    Parameters
+    ----------
+    model : SymbolicModel, optional
+        The derived model (default :func:`derive_body_frame`).
+
+    Returns
+    -------
+    dict
+        ``"printed"`` and ``"derived"`` -> det C, factored.
+    """
     model = model or derive_body_frame()
     fields = model_fields(model)
     pb = printed_brackets(model)
