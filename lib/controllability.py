@@ -48,6 +48,18 @@ def right_nested(generators: Sequence[str], order: int) -> list[Bracket]:
     r + 1 fields. There are N^(r-1) N (N-1)/2 of them for N generators, and
     they span the order-r part of the Lie algebra (every bracket is a
     combination of right-nested ones).
+
+    Parameters
+    ----------
+    generators : sequence of str
+        Field names.
+    order : int
+        Bracket order r (>= 1).
+
+    Returns
+    -------
+    list of Bracket
+        The brackets.
     """
     if order < 1:
         raise ValueError(f"order must be >= 1, got {order}")
@@ -62,7 +74,20 @@ def right_nested(generators: Sequence[str], order: int) -> list[Bracket]:
 
 
 def paper_bracket_count(w: int, r: int) -> int:
-    """The paper's count of r-th order brackets for w inputs plus a drift: w (w+1)^r / 2."""
+    """The paper's count of r-th order brackets for w inputs plus a drift: w (w+1)^r / 2.
+
+    Parameters
+    ----------
+    w : int
+        Inputs.
+    r : int
+        Order.
+
+    Returns
+    -------
+    int
+        The count as printed.
+    """
     if w < 1 or r < 1:
         raise ValueError(f"need w >= 1 and r >= 1, got w={w}, r={r}")
     return w * (w + 1) ** r // 2
@@ -70,7 +95,20 @@ def paper_bracket_count(w: int, r: int) -> int:
 
 def witt_dimension(n_generators: int, length: int) -> int:
     """Dimension of the length-k part of the free Lie algebra on N generators (Witt):
-    (1/k) sum_{d | k} mu(d) N^(k/d)."""
+    (1/k) sum_{d | k} mu(d) N^(k/d).
+
+    Parameters
+    ----------
+    n_generators : int
+        N.
+    length : int
+        k.
+
+    Returns
+    -------
+    int
+        The dimension.
+    """
     if n_generators < 1 or length < 1:
         raise ValueError(f"need N >= 1 and k >= 1, got N={n_generators}, k={length}")
     total = sum(sp.mobius(d) * n_generators ** (length // d) for d in sp.divisors(length))
@@ -94,6 +132,18 @@ def free_lie_rank(generators: Sequence[str], order: int) -> int:
     by expanding the right-nested brackets in the free associative algebra.
 
     An independent route to :func:`witt_dimension` (with length = order + 1).
+
+    Parameters
+    ----------
+    generators : sequence of str
+        Field names.
+    order : int
+        Bracket order r.
+
+    Returns
+    -------
+    int
+        The rank.
     """
     exprs = right_nested(generators, order)
     polys = [_expand_free(e) for e in exprs]
@@ -106,13 +156,41 @@ def free_lie_rank(generators: Sequence[str], order: int) -> int:
 
 def is_bad(expr: Bracket, drift: str = "f") -> bool:
     """Sussmann's bad bracket: the drift enters an odd number of times and every
-    other field an even number of times (zero included)."""
+    other field an even number of times (zero included).
+
+    Parameters
+    ----------
+    expr : Bracket
+        A bracket expression.
+    drift : str
+        The drift's name.
+
+    Returns
+    -------
+    bool
+        Whether the bracket is bad.
+    """
     deg = bracket_degree(expr)
     return deg[drift] % 2 == 1 and all(n % 2 == 0 for k, n in deg.items() if k != drift)
 
 
 def theta_degree(expr: Bracket, theta: float = 1.0, drift: str = "f") -> float:
-    """Sussmann's weighted degree theta * delta^0 + sum_i delta^i, theta in [0, 1]."""
+    """Sussmann's weighted degree theta * delta^0 + sum_i delta^i, theta in [0, 1].
+
+    Parameters
+    ----------
+    expr : Bracket
+        A bracket expression.
+    theta : float
+        The weight, in [0, 1].
+    drift : str
+        The drift's name.
+
+    Returns
+    -------
+    float
+        The weighted degree.
+    """
     if not 0.0 <= theta <= 1.0:
         raise ValueError(f"theta must lie in [0, 1], got {theta}")
     deg = bracket_degree(expr)
@@ -178,6 +256,27 @@ def sussmann_check(fields: Mapping[str, sp.MatrixBase], q, point: Mapping, *, dr
     equilibrium with zero input). A bad bracket B is *neutralised* when B(point)
     lies in the span of the good brackets of smaller theta-degree. Ranks are
     exact sympy ranks; with symbolic parameters they hold for generic values.
+
+    Parameters
+    ----------
+    fields : mapping
+        Name -> sympy column.
+    q : sequence of sympy.Symbol
+        The coordinates.
+    point : mapping
+        Substitutions for the state and parameters.
+    drift : str
+        The drift's name.
+    max_order : int
+        Highest bracket order.
+    theta : float
+        The weight of the drift's degree, in [0, 1].
+
+    Returns
+    -------
+    SussmannReport
+        The brackets at the point, the dimension n, the good brackets' rank and whether the
+        check is complete.
     """
     if max_order < 1:
         raise ValueError(f"max_order must be >= 1, got {max_order}")
@@ -209,12 +308,23 @@ def full_rank_brackets() -> list[Bracket]:
     g1, g2, [f, g1], [f, g2], [g1, [f, g2]], [[f, g1], [f, g2]].
 
     None of them is f itself, so they prove strong accessibility at every state.
+
+    Returns
+    -------
+    list of Bracket
+        The six brackets.
     """
     return ["g1", "g2", ("f", "g1"), ("f", "g2"), ("g1", ("f", "g2")), (("f", "g1"), ("f", "g2"))]
 
 
 def strong_accessibility_det() -> sp.Expr:
-    """det of :func:`full_rank_brackets` for the derived model, factored (symbolic parameters)."""
+    """det of :func:`full_rank_brackets` for the derived model, factored (symbolic parameters).
+
+    Returns
+    -------
+    sympy.Expr
+        The determinant, factored.
+    """
 
     model = derive_body_frame()
     det = accessibility_matrix(model_fields(model), full_rank_brackets(), model.q).det()
@@ -239,6 +349,20 @@ def rest_time_bound(body: Body, omega0: float, u_max: float) -> float:
     return uses u2 = -sign(omega0) u_max throughout. Before this time every
     reachable state has phi on the side of phi0 that omega0 points to, so the
     start is not an interior point of the reachable set: no STLC there.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    omega0 : float
+        Turning rate (rad/s), non-zero.
+    u_max : float
+        Bound on |u2| (N), > 0.
+
+    Returns
+    -------
+    float
+        The time (s).
     """
 
     if not np.isfinite(omega0) or omega0 == 0.0:
@@ -265,7 +389,22 @@ Field = Callable[[np.ndarray], np.ndarray]
 
 
 def fd_jacobian(field: Field, q: np.ndarray, h: float = 1e-4) -> np.ndarray:
-    """Central-difference Jacobian d field / dq (n x n), step ``h`` per coordinate."""
+    """Central-difference Jacobian d field / dq (n x n), step ``h`` per coordinate.
+
+    Parameters
+    ----------
+    field : callable
+        q -> field(q), (n,).
+    q : numpy.ndarray
+        The state (n,).
+    h : float
+        Step per coordinate.
+
+    Returns
+    -------
+    numpy.ndarray
+        The Jacobian (n, n).
+    """
     q = np.asarray(q, dtype=float)
     if q.ndim != 1 or q.size == 0:
         raise ValueError(f"q must be a non-empty 1-D array, got shape {q.shape}")
@@ -285,6 +424,22 @@ def numeric_bracket(expr: Bracket, fields: Mapping[str, Field], q, h: float = 1e
 
     Independent of the sympy route; the error grows with nesting depth (about
     h^2 truncation and eps/h^depth round-off).
+
+    Parameters
+    ----------
+    expr : Bracket
+        A bracket expression.
+    fields : mapping
+        Name -> numpy field.
+    q : array_like
+        The state (n,).
+    h : float
+        Difference step.
+
+    Returns
+    -------
+    numpy.ndarray
+        The bracket at q (n,).
     """
     q = np.asarray(q, dtype=float)
     if isinstance(expr, str):
@@ -296,7 +451,20 @@ def numeric_bracket(expr: Bracket, fields: Mapping[str, Field], q, h: float = 1e
 
 def numeric_fields(body: Body, *, printed: bool = False) -> dict[str, Field]:
     """The numpy fields of :mod:`lib.model` ({"f", "g1", "g2"}) for ``body``;
-    ``printed=True`` uses the printed drift (6)."""
+    ``printed=True`` uses the printed drift (6).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    printed : bool
+        Use the printed drift (6).
+
+    Returns
+    -------
+    dict
+        Name -> q (6,) -> field (6,).
+    """
     drift = model.f_printed if printed else model.f
     return {"f": lambda q: drift(body, q), "g1": lambda q: model.g1(body),
             "g2": lambda q: model.g2(body)}

@@ -21,7 +21,20 @@ _SIGNS = np.random.default_rng(20140307).choice([-1.0, 1.0], size=64)
 
 def perturbed(x, rel: float = ROBUST_REL) -> np.ndarray:
     """``x`` moved by ``rel`` times max(|x_i|, 1) in each entry, with fixed pseudo-random
-    signs (so an entry that is zero, such as a start at rest, moves by ``rel``)."""
+    signs (so an entry that is zero, such as a start at rest, moves by ``rel``).
+
+    Parameters
+    ----------
+    x : array_like
+        The values.
+    rel : float
+        Relative size.
+
+    Returns
+    -------
+    numpy.ndarray
+        The moved values.
+    """
     x = np.asarray(x, dtype=float)
     if not np.isfinite(rel):
         raise ValueError(f"rel must be finite, got {rel!r}")

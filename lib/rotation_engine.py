@@ -177,7 +177,28 @@ def orbit_range(eng: _Engine, x, A, B, C, k: int, slip) -> tuple[np.ndarray, np.
     orbit to its mirror image: (37) is unchanged by p(t) -> -p(t + T/2) (the eight
     reflected in its x axis half a period later), so with every orbit its mirror image is
     an orbit too, with the same multipliers; at distance 0 the orbit is its own image,
-    otherwise the two are distinct coexisting attractors (NaN on the circle)."""
+    otherwise the two are distinct coexisting attractors (NaN on the circle).
+
+    Parameters
+    ----------
+    eng : _Engine
+        The compiled engine of the points.
+    x : array_like
+        Orbit points (N, 2).
+    A, B, C : array_like
+        The coefficients of (32).
+    k : int
+        Period.
+    slip : array_like
+        Turns per k periods (N,).
+
+    Returns
+    -------
+    range : numpy.ndarray
+        Range of p (rad), (N,).
+    mirror : numpy.ndarray
+        Distance to the mirror image (rad), (N,).
+    """
     p, dp = eng.record(x[:, 0], x[:, 1], A, B, C, k)
     N, n = x.shape[0], eng.n
     mirror = np.full(N, np.nan)
