@@ -144,7 +144,22 @@ def rotating_to_inertial(y, Theta: float, t: float) -> np.ndarray:
     """The inertial state s = (x, y, phi, x', y', phi') (m, rad, m/s, rad/s) at time ``t`` (s) of
     the rotating-frame state ``y`` = (xi, eta, p, xi', eta', p') (shape (..., 6)) on the circle
     run at ``Theta`` (rad/s): X = Rot(Theta t) (xi, eta), X' = Rot(Theta t) [(xi', eta') +
-    Theta S (xi, eta)] with S the rotation by pi/2, phi = p + Theta t + pi/2, phi' = p' + Theta."""
+    Theta S (xi, eta)] with S the rotation by pi/2, phi = p + Theta t + pi/2, phi' = p' + Theta.
+
+    Parameters
+    ----------
+    y : array_like
+        Rotating-frame states (..., 6) (m, m, rad, m/s, m/s, rad/s).
+    Theta : float
+        Rate (rad/s).
+    t : float
+        Time (s).
+
+    Returns
+    -------
+    numpy.ndarray
+        Inertial states (..., 6) in the same units.
+    """
     y = np.asarray(y, dtype=float)
     c, s = _rot(Theta * t)
     xi, eta, p, dxi, deta, dp = np.moveaxis(y, -1, 0)
@@ -154,7 +169,22 @@ def rotating_to_inertial(y, Theta: float, t: float) -> np.ndarray:
 
 
 def inertial_to_rotating(s, Theta: float, t: float) -> np.ndarray:
-    """The inverse of :func:`rotating_to_inertial`."""
+    """The inverse of :func:`rotating_to_inertial`.
+
+    Parameters
+    ----------
+    s : array_like
+        Inertial states (..., 6) (m, m, rad, m/s, m/s, rad/s).
+    Theta : float
+        Rate (rad/s).
+    t : float
+        Time (s).
+
+    Returns
+    -------
+    numpy.ndarray
+        Rotating-frame states (..., 6).
+    """
     s = np.asarray(s, dtype=float)
     c, sn = _rot(Theta * t)
     x, y, phi, dx, dy, dphi = np.moveaxis(s, -1, 0)
@@ -182,7 +212,30 @@ def rotating_field(body: Body, gains: Gains, R: float, Theta: float, weights, y,
     """The closed loop on the circle (27) with the weighted allocation, written in the frame
     rotating with the reference: y' for states y = (xi, eta, p, xi', eta', p') of shape (..., 6)
     (m, m, rad, m/s, m/s, rad/s), from :meth:`lib.closed_loop.ClosedLoop.rates` evaluated at
-    time ``t`` (s). Autonomous: the result does not depend on ``t`` (up to rounding)."""
+    time ``t`` (s). Autonomous: the result does not depend on ``t`` (up to rounding).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    R : float
+        Radius (m), > 0.
+    Theta : float
+        Rate (rad/s), > 0.
+    weights : array_like
+        (w_x, w_y, w_phi).
+    y : array_like
+        Rotating-frame states (..., 6).
+    t : float
+        Time (s).
+
+    Returns
+    -------
+    numpy.ndarray
+        y' (..., 6) (m/s, m/s, rad/s, m/s^2, m/s^2, rad/s^2).
+    """
     R, Theta = _check(body, gains, R, Theta)
     weights = _check_weights(weights)
     if isinstance(t, bool) or not np.isscalar(t) or not np.isfinite(t):
@@ -261,7 +314,29 @@ def circle_steady_state(body: Body, gains: Gains, R: float, Theta: float, weight
     to the inertial one (the result does not depend on it; a check). Raises ValueError when R
     is below the critical radius (36) (no equilibrium at w_phi = 0) and RuntimeError when the
     continuation fails before w_phi (the branch has folded back: no steady state on it at this
-    weight)."""
+    weight).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    R : float
+        Radius (m), > 0.
+    Theta : float
+        Rate (rad/s), > 0.
+    weights : array_like
+        (w_x, w_y, w_phi), w_x = w_y > 0.
+    t : float
+        Time (s) of the check.
+
+    Returns
+    -------
+    CircleSteadyState
+        radial, tangential (m) and heading (rad) errors, the six eigenvalues (1/s), the
+        rotating-frame state and the weights.
+    """
     R, Theta = _check(body, gains, R, Theta)
     w = _check_weights(weights)
     if isinstance(t, bool) or not np.isscalar(t) or not np.isfinite(t):
@@ -279,7 +354,26 @@ def circle_weight_sweep(body: Body, gains: Gains, R: float, Theta: float, w_phi)
     Returns a DataFrame, one row per weight (in the order given): w_phi, radial, tangential,
     position_error (m), heading (rad), max_real (1/s, largest real part of the eigenvalues),
     max_imag (rad/s, |imaginary part| of that eigenvalue) and stable; NaN (and stable False)
-    where the branch no longer exists."""
+    where the branch no longer exists.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    R : float
+        Radius (m), > 0.
+    Theta : float
+        Rate (rad/s), > 0.
+    w_phi : array_like
+        The weights.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per weight (columns above).
+    """
     R, Theta = _check(body, gains, R, Theta)
     wp = np.atleast_1d(np.asarray(w_phi, dtype=float))
     if wp.ndim != 1 or wp.size == 0 or not np.all(np.isfinite(wp)) or np.any(wp < 0):
@@ -313,7 +407,28 @@ def circle_weight_limit(body: Body, gains: Gains, R: float, Theta: float, w_max:
     down to ``rtol``), the branch has
     folded back: kind "fold" at the last weight with an equilibrium. Raises ValueError when the
     steady motion is unstable already at w_phi = 0 and RuntimeError when no limit lies below
-    ``w_max``."""
+    ``w_max``.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    R : float
+        Radius (m), > 0.
+    Theta : float
+        Rate (rad/s), > 0.
+    w_max : float
+        Largest weight searched.
+    rtol : float
+        Relative tolerance in w_phi.
+
+    Returns
+    -------
+    WeightLimit
+        w_phi, kind, the eigenvalue (1/s) there, the steady state and rtol.
+    """
     R, Theta = _check(body, gains, R, Theta)
     for name, v, lo in (("w_max", w_max, _CONT_START), ("rtol", rtol, 0.0)):
         if isinstance(v, bool) or not np.isscalar(v) or not np.isfinite(v) or not v > lo:
@@ -373,7 +488,30 @@ def circle_error_weight(body: Body, gains: Gains, R: float, Theta: float, level:
     log w_phi to relative ``rtol``). It is the exact counterpart of a tolerance on the position
     error met by the steady motion (e.g. 0.1 R, the tolerance of "held"), whether or not that
     motion is still stable there. Raises RuntimeError when the branch ends (a fold) or
-    ``w_max`` is passed first."""
+    ``w_max`` is passed first.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    R : float
+        Radius (m), > 0.
+    Theta : float
+        Rate (rad/s), > 0.
+    level : float
+        The position error (m).
+    w_max : float
+        Largest weight searched.
+    rtol : float
+        Relative tolerance in w_phi.
+
+    Returns
+    -------
+    float
+        w_phi.
+    """
     R, Theta = _check(body, gains, R, Theta)
     for name, v in (("level", level), ("w_max", w_max), ("rtol", rtol)):
         if isinstance(v, bool) or not np.isscalar(v) or not np.isfinite(v) or not v > 0:
