@@ -22,7 +22,34 @@ def animate(res, body: Body, *, n_frames: int = 60, t_from: float = 0.0, dpi: in
     """HTML (``FuncAnimation.to_jshtml``) of the body following its path: outline,
     force arrow (red, applied at distance a ahead of C) and the trace of C, for
     ``n_frames`` instants from ``t_from`` (s) to the end of ``res``.
-    Frames are PNGs inlined in the HTML; size grows with ``n_frames``, ``dpi`` and ``figsize``."""
+    Frames are PNGs inlined in the HTML; size grows with ``n_frames``, ``dpi`` and ``figsize``.
+
+    Parameters
+    ----------
+    res : SimulationResult
+        A run.
+    body : Body
+        The body.
+    n_frames : int
+        Frames (>= 2).
+    t_from : float
+        Start (s).
+    dpi : int
+        Resolution.
+    figsize : tuple
+        Figure size (in).
+    force_scale : float
+        Arrow length per newton (m/N).
+    fps : int
+        Frames per second.
+    lim : tuple, optional
+        Axis limits (m).
+
+    Returns
+    -------
+    str
+        HTML.
+    """
     import matplotlib.pyplot as plt
     from matplotlib.animation import FuncAnimation
     from matplotlib.patches import Polygon
@@ -73,7 +100,18 @@ _ICONS = {
 
 def offline_controls(jshtml: str) -> str:
     """Make matplotlib's ``to_jshtml`` output self-contained: drop the stylesheet link
-    to the Font Awesome CDN and replace each icon by a Unicode symbol."""
+    to the Font Awesome CDN and replace each icon by a Unicode symbol.
+
+    Parameters
+    ----------
+    jshtml : str
+        matplotlib's ``to_jshtml`` output.
+
+    Returns
+    -------
+    str
+        The HTML, self-contained.
+    """
     out = re.sub(r"<link[^>]*font-awesome[^>]*>", "", jshtml, flags=re.S)
     for cls, sym in _ICONS.items():
         out = out.replace(f'<i class="{cls}"></i>', f"<span>{sym}</span>")
@@ -84,7 +122,22 @@ def offline_controls(jshtml: str) -> str:
 
 def csv_link(frame, filename: str, label: str | None = None) -> str:
     """An HTML link that downloads ``frame`` (a pandas DataFrame) as ``filename``;
-    the CSV is inlined as a base64 ``data:`` URI, so it works offline."""
+    the CSV is inlined as a base64 ``data:`` URI, so it works offline.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        The data.
+    filename : str
+        Must end in ``.csv``.
+    label : str, optional
+        The link text.
+
+    Returns
+    -------
+    str
+        HTML.
+    """
     if not filename.endswith(".csv"):
         raise ValueError(f"filename must end in .csv, got {filename!r}")
     data = base64.b64encode(frame.to_csv(index=False).encode()).decode()

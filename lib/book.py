@@ -19,6 +19,19 @@ def glue(name: str, value, display: bool = False) -> None:
     NumPy scalars are converted to Python numbers first: their repr
     (``np.float64(1.5)``) cannot be formatted by myst-nb's ``fmt`` spec.
     Non-finite numbers are refused: a NaN in the prose is always a bug.
+
+    Parameters
+    ----------
+    name : str
+        The glue key.
+    value : Any
+        A finite number or a string.
+    display : bool
+        Show the value in the cell's output.
+
+    Returns
+    -------
+    None
     """
     from myst_nb import glue as _glue
 
@@ -32,7 +45,19 @@ def glue(name: str, value, display: bool = False) -> None:
 def glue_all(values, prefix: str = "") -> None:
     """Glue every entry of ``values`` as ``prefix + key``: a mapping, or an object with
     fields (a dataclass, a :class:`typing.NamedTuple`). Lets a chapter glue the result
-    object of a claim in one call, e.g. ``glue_all(summary, "cap_")``."""
+    object of a claim in one call, e.g. ``glue_all(summary, "cap_")``.
+
+    Parameters
+    ----------
+    values : mapping or dataclass or NamedTuple
+        The values.
+    prefix : str
+        Prefix of every key.
+
+    Returns
+    -------
+    None
+    """
     if is_dataclass(values) and not isinstance(values, type):
         values = {f.name: getattr(values, f.name) for f in fields(values)}
     elif hasattr(values, "_asdict"):
@@ -50,6 +75,18 @@ def markdown_table(frame, index: bool = False):
     becomes ``\\|`` and a newline a space, so the table keeps its columns.
 
     Needs ``nb_render_markdown_format: myst`` (set in ``_config.yml``).
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        The table.
+    index : bool
+        Include the index.
+
+    Returns
+    -------
+    IPython.display.Markdown
+        The table.
     """
     from IPython.display import Markdown
 
@@ -68,7 +105,20 @@ def markdown_table(frame, index: bool = False):
 def with_alt(snippet: str, alt: str) -> str:
     """``snippet`` (HTML, e.g. an animation from :func:`lib.animation.animate`) with ``alt``
     as the alt text of every ``<img>`` that has none, so that a figure shown as HTML says
-    what it shows, as ``mystnb: image: alt:`` does for an image output."""
+    what it shows, as ``mystnb: image: alt:`` does for an image output.
+
+    Parameters
+    ----------
+    snippet : str
+        HTML.
+    alt : str
+        Alt text, a sentence.
+
+    Returns
+    -------
+    str
+        The HTML.
+    """
     if not alt.strip():
         raise ValueError("an alt text must say what the image shows")
     attr = f' alt="{html.escape(alt.strip(), quote=True)}"'

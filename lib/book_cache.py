@@ -28,7 +28,18 @@ _LIB = Path(__file__).resolve().parent
 
 def cache_dir(start: Path | None = None) -> Path:
     """``_build/.cache`` of the book that contains ``start`` (default: the working directory):
-    the nearest folder upwards that holds ``_config.yml``. Raises FileNotFoundError outside a book."""
+    the nearest folder upwards that holds ``_config.yml``. Raises FileNotFoundError outside a book.
+
+    Parameters
+    ----------
+    start : pathlib.Path, optional
+        Where to start looking.
+
+    Returns
+    -------
+    pathlib.Path
+        The cache folder.
+    """
     here = Path(start or os.getcwd()).resolve()
     for d in (here, *here.parents):
         if (d / "_config.yml").is_file() and (d / "_toc.yml").is_file():
@@ -66,13 +77,41 @@ def _key(fn: Callable, args, kwargs) -> str:
 def cached(fn: Callable, *args, **kwargs) -> Any:
     """``fn(*args, **kwargs)``, computed once per state of the library and shared between the
     notebooks of one book build (a pickle under :func:`cache_dir`). The arguments must have a
-    faithful ``repr`` (numbers, strings, arrays, the frozen parameter dataclasses)."""
+    faithful ``repr`` (numbers, strings, arrays, the frozen parameter dataclasses).
+
+    Parameters
+    ----------
+    fn : callable
+        A module-level function.
+    *args, **kwargs
+        Its arguments.
+
+    Returns
+    -------
+    Any
+        ``fn(*args, **kwargs)``.
+    """
     return cached_timed(fn, *args, **kwargs)[0]
 
 
 def cached_timed(fn: Callable, *args, **kwargs) -> tuple[Any, float]:
     """:func:`cached`, and the wall time (s) the computation took when it was done. Outside a
-    book (no ``_config.yml`` above the working directory) it simply computes."""
+    book (no ``_config.yml`` above the working directory) it simply computes.
+
+    Parameters
+    ----------
+    fn : callable
+        A module-level function.
+    *args, **kwargs
+        Its arguments.
+
+    Returns
+    -------
+    result : Any
+        ``fn(*args, **kwargs)``.
+    seconds : float
+        The wall time (s) of the computation.
+    """
     try:
         path = cache_dir() / f"{fn.__name__}-{_key(fn, args, kwargs)}.pkl"
     except FileNotFoundError:

@@ -20,7 +20,22 @@ __all__ = ["body_outline", "draw_body", "new_axes", "plot_path", "plot_errors", 
 
 
 def new_axes(ax=None, **subplot_kw):
-    """Return (fig, ax), creating them when ``ax`` is None."""
+    """Return (fig, ax), creating them when ``ax`` is None.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes, optional
+        Existing axes.
+    **subplot_kw
+        Keywords of ``plt.subplots``.
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+        The figure.
+    ax : matplotlib.axes.Axes
+        The axes.
+    """
     if ax is None:
         fig, ax = plt.subplots(**subplot_kw)
         return fig, ax
@@ -29,7 +44,24 @@ def new_axes(ax=None, **subplot_kw):
 
 def body_outline(body: Body, x: float, y: float, phi: float, scale: float = 1.0) -> np.ndarray:
     """Corners (m) of a boat-shaped outline of the body: symmetric about its axis,
-    length 2.5 a, bow forward, so that the force point (a ahead of C) lies inside it."""
+    length 2.5 a, bow forward, so that the force point (a ahead of C) lies inside it.
+
+    Parameters
+    ----------
+    body : Body
+        The body (its a).
+    x, y : float
+        Position of C (m).
+    phi : float
+        Heading (rad).
+    scale : float
+        Drawing scale.
+
+    Returns
+    -------
+    numpy.ndarray
+        Corners (m), (n, 2).
+    """
     L, W = 1.25 * body.a * scale, 0.45 * body.a * scale
     local = np.array([[L, 0.0], [0.4 * L, W], [-L, W], [-L, -W], [0.4 * L, -W]])
     c, s = np.cos(phi), np.sin(phi)
@@ -45,6 +77,34 @@ def draw_body(x: float, y: float, phi: float, body: Body, F: float | None = None
     at r = a e1 is a F sin(beta), as printed; at -a e1 it would be -a F sin(beta).
 
     ``force_scale`` is metres of arrow per newton. Returns the figure.
+
+    Parameters
+    ----------
+    x, y : float
+        Position of C (m).
+    phi : float
+        Heading (rad).
+    body : Body
+        The body.
+    F : float, optional
+        Force (N).
+    beta : float, optional
+        Its angle to the axis (rad).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (default new ones).
+    force_scale : float
+        Arrow length per newton (m/N).
+    scale : float
+        Drawing scale.
+    color : str
+        Colour.
+    axes_arrows : bool
+        Draw the body axes.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
     """
     fig, ax = new_axes(ax)
     ax.add_patch(Polygon(body_outline(body, x, y, phi, scale), closed=True, fc=color, ec="k", alpha=0.35, lw=1))
@@ -72,7 +132,32 @@ def plot_path(res, body: Body, *, ax=None, n_bodies: int = 10, force_scale: floa
     """Fig. 2a/3a: the reference path (dashed), the path of C, and the body with its
     force vector at ``n_bodies`` regular instants from ``t_from`` (s) to the end
     (excluded when ``endpoint`` is False, e.g. over one whole period, where the
-    first and last instants coincide). Returns the figure."""
+    first and last instants coincide). Returns the figure.
+
+    Parameters
+    ----------
+    res : SimulationResult
+        A run.
+    body : Body
+        The body.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (default new ones).
+    n_bodies : int
+        Bodies drawn.
+    force_scale : float
+        Arrow length per newton (m/N).
+    t_from : float
+        Start (s).
+    scale : float
+        Drawing scale.
+    reference, endpoint : bool
+        Draw the reference; include the last instant.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, ax = new_axes(ax)
     if reference:
         ax.plot(res.z_d[:, 0], res.z_d[:, 1], "k--", lw=1, label="reference")
@@ -88,7 +173,22 @@ def plot_path(res, body: Body, *, ax=None, n_bodies: int = 10, force_scale: floa
 
 def plot_errors(res, *, ax=None, p=None):
     """Fig. 2b/3b: position errors e_x, e_y (m) and the rotation error p = phi - phi_d (rad)
-    against time. ``p`` overrides the rotation error (e.g. a continuous version)."""
+    against time. ``p`` overrides the rotation error (e.g. a continuous version).
+
+    Parameters
+    ----------
+    res : SimulationResult
+        A run.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (default new ones).
+    p : array_like, optional
+        The rotation error to plot (rad).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, ax = new_axes(ax)
     e = res.error
     ax.plot(res.t, e[:, 0], "C0", label=r"$e_x$ (m)")
@@ -101,7 +201,24 @@ def plot_errors(res, *, ax=None, p=None):
 
 
 def plot_force(res, cap: float | None = None, *, ax=None, intervals=None):
-    """Force magnitude F (N) against time, with the cap and the saturated intervals shaded."""
+    """Force magnitude F (N) against time, with the cap and the saturated intervals shaded.
+
+    Parameters
+    ----------
+    res : SimulationResult
+        A run.
+    cap : float, optional
+        The cap (N).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (default new ones).
+    intervals : list of tuple, optional
+        Saturated intervals (s).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, ax = new_axes(ax)
     ax.plot(res.t, res.F, "C3", lw=1)
     if cap is not None:
@@ -115,7 +232,26 @@ def plot_force(res, cap: float | None = None, *, ax=None, intervals=None):
 
 def plot_bifurcation(angle_limits, sections, column: int = 4, *, ax=None, label: str = r"$p$ at $t=kT$ (rad)"):
     """Bifurcation diagram: for each angle limit (rad, plotted in degrees), the chosen
-    column of its stroboscopic section (default the rotation error p)."""
+    column of its stroboscopic section (default the rotation error p).
+
+    Parameters
+    ----------
+    angle_limits : array_like
+        beta_max (rad).
+    sections : sequence of numpy.ndarray
+        One section (n, 6) per limit.
+    column : int
+        The error state's column.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (default new ones).
+    label : str
+        The y label.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, ax = new_axes(ax)
     for b, sec in zip(angle_limits, sections):
         ax.plot(np.full(len(sec), np.rad2deg(b)), sec[:, column], "k.", ms=2)
@@ -125,7 +261,26 @@ def plot_bifurcation(angle_limits, sections, column: int = 4, *, ax=None, label:
 
 def plot_section(section, i: int = 0, j: int = 4, *, ax=None, color: str = "k", label=None):
     """Stroboscopic (Poincaré) section: column ``j`` against column ``i`` of an error-state
-    array [e_x, e_y, de_x, de_y, p, dp]."""
+    array [e_x, e_y, de_x, de_y, p, dp].
+
+    Parameters
+    ----------
+    section : array_like
+        Error states (n, 6).
+    i, j : int
+        Columns plotted.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (default new ones).
+    color : str
+        Colour.
+    label : str, optional
+        Legend label.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     names = [r"$e_x$ (m)", r"$e_y$ (m)", r"$\dot e_x$ (m/s)", r"$\dot e_y$ (m/s)", r"$p$ (rad)", r"$\dot p$ (rad/s)"]
     fig, ax = new_axes(ax)
     ax.plot(section[:, i], section[:, j], ".", color=color, ms=3, label=label)
@@ -155,7 +310,20 @@ def plot_fig5(frame: pd.DataFrame, ax=None):
     """Fig. 5: range (rad) of the rotation error over the attracting orbit at the periodic
     points of a rectangular (R, Theta) grid (:func:`lib.rotation_verdicts.rotation_verdicts`), the
     other regimes in flat colours (:data:`REGIME_COLORS`), and the points where stability
-    is lost (column ``lost``) ringed, as the paper's empty circles. Returns the figure."""
+    is lost (column ``lost``) ringed, as the paper's empty circles. Returns the figure.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        Verdicts on a rectangular grid.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (default new ones).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, ax = new_axes(ax, figsize=(7, 5))
     R, Th, rng = _grid(frame, "range")
     _, _, per = _grid(frame.assign(is_per=(frame.regime == "periodic").astype(float)), "is_per")
@@ -181,7 +349,18 @@ def plot_fig5(frame: pd.DataFrame, ax=None):
 def plot_fig5_exponents(frame: pd.DataFrame):
     """Beside Fig. 5: the largest Floquet multiplier modulus of the attracting orbit
     (periodic and slipping points) and the largest Lyapunov exponent (1/s) of the
-    other points, on the same (R, Theta) grid. Returns the figure."""
+    other points, on the same (R, Theta) grid. Returns the figure.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        Verdicts on a rectangular grid.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.4), sharey=True, layout="constrained")
     R, Th, flo = _grid(frame, "floquet")
     _, _, lya = _grid(frame.assign(ly=np.where(frame.regime.isin(["periodic", "slipping"]), np.nan, frame.lyapunov)),
@@ -202,7 +381,24 @@ def plot_fig5_exponents(frame: pd.DataFrame):
 def plot_circle_map(frame: pd.DataFrame, body: Body, coexists=None, ax=None):
     """Where the circle's rotation error settles or slips (``frame`` from
     :func:`lib.circle_rotation.circle_final_state`), with the analytic boundary R_crit(theta) of (36)
-    and, if given, the points where slipping coexists with the stable equilibrium."""
+    and, if given, the points where slipping coexists with the stable equilibrium.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        End states of :func:`lib.circle_rotation.circle_final_state`.
+    body : Body
+        The body.
+    coexists : array_like, optional
+        Per point, whether slipping coexists.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (default new ones).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     if ax is None:
         fig, ax = plt.subplots(figsize=(7, 5))
     for regime, style in (("settled", dict(color="C0", marker=".")), ("slipping", dict(color="C3", marker="x"))):
@@ -225,7 +421,24 @@ def plot_heading_orbits(orbits: dict, t, p, distances: dict, multiplier: float):
     one period (``orbits``: label -> :class:`lib.rotation_attractor.RotationAttractor`) with the
     run's last period (t (s), p (rad)) on top; (b) the run's distance to each orbit per
     period (``distances``: label -> array, from ``distance_per_period``) on a log scale,
-    with the rate |mu_1|^j of the slowest Floquet multiplier ``multiplier``. Returns the figure."""
+    with the rate |mu_1|^j of the slowest Floquet multiplier ``multiplier``. Returns the figure.
+
+    Parameters
+    ----------
+    orbits : dict
+        Label -> RotationAttractor.
+    t, p : array_like
+        The run's last period: times (s) and p (rad).
+    distances : dict
+        Label -> distance per period (rad).
+    multiplier : float
+        The slowest multiplier, for the expected rate.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2), layout="constrained")
     for i, (label, orb) in enumerate(orbits.items()):
         a.plot(orb.t, orb.p, color=f"C{i}", lw=2, label=f"orbit {label}")
@@ -258,7 +471,28 @@ def plot_limit_sweep(frame: pd.DataFrame, sections, *, axes, column: int = 4,
     it, on two axes sharing the angle axis: ``axes`` = (top, bottom). Top: the chosen column
     of each run's section (error states at t = kT, ``sections`` (N, L, 6)), coloured by the
     regime in ``frame`` (:func:`lib.limits.limit_verdicts`); bottom: lambda_1 (1/s) with
-    +-3 standard errors, and zero. Returns the figure."""
+    +-3 standard errors, and zero. Returns the figure.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        Verdicts of :func:`lib.limits.limit_verdicts`.
+    sections : array_like
+        Sections (N, L, 6).
+    axes : tuple of matplotlib.axes.Axes
+        (top, bottom).
+    column : int
+        The error state's column.
+    label : str
+        The y label.
+    title : str, optional
+        Title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     top, bot = axes
     deg = frame.angle_deg.to_numpy()
     for regime, color in LIMIT_COLORS.items():
@@ -279,7 +513,20 @@ def plot_limit_sweep(frame: pd.DataFrame, sections, *, axes, column: int = 4,
 def plot_limit_map(frame: pd.DataFrame, *, ax=None):
     """Regime map over (angle limit, force cap) from :func:`lib.limits.limit_verdicts`: one
     cell per run, coloured by regime, periodic cells labelled with their period; the
-    uncapped runs (force_limit inf) form the top row. Returns the figure."""
+    uncapped runs (force_limit inf) form the top row. Returns the figure.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        Verdicts of :func:`lib.limits.limit_verdicts`.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (default new ones).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     fig, ax = new_axes(ax, figsize=(8, 4))
     caps = np.sort(frame.force_limit.unique())
     angles = np.sort(frame.angle_deg.unique())
@@ -308,7 +555,30 @@ def plot_bistable_window(theta, r_crit, r_edge, grid: pd.DataFrame, grid_r_crit,
     :func:`lib.circle_rotation.bistable_window`; over it the grid points of
     :func:`lib.circle_rotation.circle_final_state` (``grid``, with R_crit per point ``grid_r_crit``) where a
     slipping motion coexists (``coexists``, by simulation) or not; a dashed line at
-    ``theta_close`` and, if given, ``mark`` = (theta, R_edge/R_crit - 1) as a star."""
+    ``theta_close`` and, if given, ``mark`` = (theta, R_edge/R_crit - 1) as a star.
+
+    Parameters
+    ----------
+    theta, r_crit, r_edge : array_like
+        Rates (rad/s) and the window's edges (m).
+    grid : pandas.DataFrame
+        Simulated points.
+    grid_r_crit : array_like
+        R_crit (m) per grid point.
+    coexists : array_like
+        Per grid point, whether slipping coexists.
+    theta_close : float
+        The closing rate (rad/s).
+    mark : float, optional
+        A rate (rad/s) to mark.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (default new ones).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     if ax is None:
         fig, ax = plt.subplots(figsize=(7, 4.5))
     theta, excess = np.asarray(theta), np.asarray(r_edge) / np.asarray(r_crit) - 1.0
