@@ -43,7 +43,26 @@ def _kernel(phi, w, A, B, C, X1, Y1, X2, Y2, hA, hB, out, out_w):
 def rotation_period(phi, w, A, B, C, h, X1, Y1, X2, Y2, hA, hB):
     """One period of n fixed steps for N points: the unit reference's derivatives
     X1.. are tabulated at the stage phases, shape (n, stages). Returns ((phi, w) at
-    every step end, each (n, N)), final phi, final w)."""
+    every step end, each (n, N)), final phi, final w).
+
+    Parameters
+    ----------
+    phi, w : numpy.ndarray
+        Heading (rad) and w = d phi / ds, (N,).
+    A, B, C : numpy.ndarray
+        The coefficients of (32), (N,).
+    h : float
+        The phase step.
+    X1, Y1, X2, Y2 : numpy.ndarray
+        The unit reference's derivatives at the stage phases, (n, stages).
+    hA, hB : numpy.ndarray
+        The tableau times the step.
+
+    Returns
+    -------
+    tuple
+        ((phi, w) at every step end, each (n, N)), final phi, final w.
+    """
     phi, w = np.array(phi, dtype=float), np.array(w, dtype=float)
     out = np.empty((X1.shape[0], phi.size))
     out_w = np.empty_like(out)
@@ -145,7 +164,34 @@ def rotation_flow(phi, w, A, B, C, periods, X1, Y1, X2, Y2, hA, hB, *, J=None, j
 
     Returns a dict: phi, w (N,) final; J (N, 2, 2); sec (P, N, 2) the raw (phi, w) at the end
     of each period (P = max periods; NaN past a point's own count); logs (P, N) the log
-    growth of the tangent vector per period (with ``renorm``); pmin, pmax (N,) (with ``H``)."""
+    growth of the tangent vector per period (with ``renorm``); pmin, pmax (N,) (with ``H``).
+
+    Parameters
+    ----------
+    phi, w : numpy.ndarray
+        Heading (rad) and w = d phi / ds, (N,).
+    A, B, C : numpy.ndarray
+        The coefficients of (32), (N,).
+    periods : int or numpy.ndarray
+        Periods, one or per point.
+    X1, Y1, X2, Y2 : numpy.ndarray
+        The unit reference's derivatives at the stage phases, (n, stages).
+    hA, hB : numpy.ndarray
+        The tableau times the step.
+    J : numpy.ndarray, optional
+        Initial variational matrix (N, 2, 2).
+    jac, renorm : bool
+        Run the variational equation; renormalise its first column every period.
+    H : numpy.ndarray, optional
+        The reference heading at the step ends (rad), (n,).
+    wind2pi : float
+        The heading's winding per period (rad).
+
+    Returns
+    -------
+    dict
+        phi, w, J, sec, logs, pmin, pmax (see above).
+    """
     phi = np.array(phi, dtype=float, ndmin=1)
     w = np.array(w, dtype=float, ndmin=1)
     N = phi.size

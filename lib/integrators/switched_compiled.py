@@ -437,7 +437,32 @@ def run_periods(P: np.ndarray, angle_limits: np.ndarray, force_limits: np.ndarra
     ends (N, n_periods + 1, 6), the final modes (N,), log(d/d0) of the companion per
     period from ``lyapunov_from`` on (N, n_periods - lyapunov_from; -1 for none) and the
     statistics (N, 6): crossings, slides, time sliding (s), events, failure flag
-    (1: an accumulation of events, 2: a non-finite state), real steps spent locating events."""
+    (1: an accumulation of events, 2: a non-finite state), real steps spent locating events.
+
+    Parameters
+    ----------
+    P : numpy.ndarray
+        The packed parameters of body, gains and reference.
+    angle_limits, force_limits : numpy.ndarray
+        beta_max (rad) and F_max (N, inf for none), (N,).
+    S0 : numpy.ndarray
+        Start states (N, 6).
+    n_periods, steps_per_period : int
+        Periods and fixed steps per period.
+    period, t0 : float
+        The reference period and the start time (s).
+    lyapunov_from : int
+        First period of the companion (-1 for none).
+    d0 : float
+        The companion's initial separation.
+    A, b, c : numpy.ndarray
+        The Runge-Kutta tableau.
+
+    Returns
+    -------
+    tuple
+        States (N, n_periods + 1, 6), final modes (N,), log-growths and statistics (N, 6).
+    """
     N = S0.shape[0]
     sections = np.full((N, n_periods + 1, 6), np.nan)
     modes = np.zeros(N, dtype=np.int64)
