@@ -47,6 +47,23 @@ def test_public_api_has_numpydoc_parameters_and_returns(path):
         assert re.search(r"^Returns\n-{7}$", doc, re.M), f"{path}: no Returns section"
 
 
+def test_every_public_function_has_numpydoc_sections():
+    # the book's rule for lib functions: numpydoc Parameters / Returns (lib.paper, the
+    # verdicts on the paper, is not part of the library's API)
+    missing = []
+    for m in pkgutil.walk_packages(lib.__path__, "lib."):
+        if m.name.startswith("lib.paper"):
+            continue
+        mod = importlib.import_module(m.name)
+        for name, obj in vars(mod).items():
+            if name.startswith("_") or not inspect.isfunction(obj) or obj.__module__ != mod.__name__:
+                continue
+            doc = inspect.getdoc(obj) or ""
+            if not re.search(r"^(Parameters\n-{10}|Returns\n-{7})$", doc, re.M):
+                missing.append(f"{m.name}.{name}")
+    assert missing == []
+
+
 def test_every_module_is_on_the_reference_page():
     page = (ROOT / "reference.md").read_text()
     on_page = set(re.findall(r"^\.\. automodule:: (\S+)$", page, re.M))
