@@ -305,3 +305,385 @@ def test_enclosed_orbit_finds_an_attracting_or_repelling_fixed_point_inside_a_cu
                                        newton_options=dict(max_iter=10))
     assert attracting.tolist() == [True, False]
     np.testing.assert_allclose(mu, gains, rtol=1e-13)  # measured 0
+
+
+# ---------------------------------------------------------------- find_orbits and its steps on a toy period map
+# (the survivors of the first mutation run of lib/dynamics/verdicts.py, mutation/REPORT.md). The map's
+# orbits, multipliers and turns are known in closed form, so every field find_orbits returns is
+# checked against them; the heading is column 1, so that no step may assume it is column 0.
+
+TWO_PI = 2 * np.pi
+
+
+class ToyMap:
+    """A period map with known orbits, one parameter set per row. Column 0: x; column 1: the
+    heading phi (``turn_axis`` 1). phi' = phi + 2 pi s + (a - 1) g(phi - phi0), with g = sin
+    (an angle: the map commutes with whole turns; phi0 attracts for |a| < 1, phi0 + pi repels)
+    or g(u) = u (``angle`` False: a plain coordinate, one fixed point). x' = b x (mode 1: a fixed
+    point at 0, multiplier b); x' = -h(x), h(x) = x - c (x^3 - q^2 x), c = (1 - b) / (2 q^2)
+    (mode 2: a 2-cycle +-q, multiplier b^2 in x per two periods); x' = x + 1e-6 (2 + sin x)
+    (mode 3: no fixed point, and DP - I singular only where cos x = 0 exactly). One period's
+    multipliers are those of the diagonal Jacobian: b (or h', 1 + 1e-6 cos x) and 1 + (a - 1) g'."""
+
+    turn_axis = 1
+
+    def __init__(self, **rows):
+        defaults = dict(s=0, a=0.5, b=0.25, mode=1, phi0=0.3, angle=True, q=0.3)
+        self.p = {key: np.atleast_1d(rows.get(key, val)) for key, val in defaults.items()}
+
+    def _one(self, idx, X):
+        p = {key: v[idx] if v.size > 1 else np.repeat(v, len(idx)) for key, v in self.p.items()}
+        x, phi = X[:, 0], X[:, 1]
+        u = phi - p["phi0"]
+        g, dg = np.where(p["angle"], np.sin(u), u), np.where(p["angle"], np.cos(u), 1.0)
+        c = (1 - p["b"]) / (2 * p["q"] ** 2)
+        xn = np.select([p["mode"] == 1, p["mode"] == 2], [p["b"] * x, -(x - c * (x ** 3 - p["q"] ** 2 * x))],
+                       x + 1e-6 * (2 + np.sin(x)))
+        dx = np.select([p["mode"] == 1, p["mode"] == 2], [p["b"] + 0 * x, -(1 - c * (3 * x ** 2 - p["q"] ** 2))],
+                       1 + 1e-6 * np.cos(x))
+        J = np.zeros((len(idx), 2, 2))
+        J[:, 0, 0], J[:, 1, 1] = dx, 1 + (p["a"] - 1) * dg
+        return np.column_stack([xn, phi + TWO_PI * p["s"] + (p["a"] - 1) * g]), J
+
+    def step(self, idx, X, k):
+        """P^k and DP^k (the chain rule), as newton wants them."""
+        idx = np.asarray(idx)
+        k = np.broadcast_to(np.asarray(k, dtype=int), (len(idx),))
+        y, J = np.array(X, dtype=float), np.tile(np.eye(2), (len(idx), 1, 1))
+        for j in range(int(k.max(initial=0))):
+            act = k > j
+            y[act], Jj = self._one(idx[act], y[act])
+            J[act] = Jj @ J[act]
+        return y, J
+
+    def advance(self, idx, X, k):
+        return self.step(idx, X, k)[0]
+
+    def run(self, x0, L):
+        """Sections (L, N, 2) of the runs of every row from the starts x0 (N, 2)."""
+        out = [np.array(x0, dtype=float)]
+        for _ in range(L - 1):
+            out.append(self.advance(np.arange(len(out[0])), out[-1], 1))
+        return np.stack(out)
+
+
+OPTS = dict(max_period=4, candidate_tol=1e-3, newton_tol=1e-12, reach_tol=0.05, reach_floor=1e-9,
+            newton_options=dict(max_iter=20))
+
+
+def _find(pm, hist, **kw):
+    return dv.find_orbits(pm.step, pm, np.arange(hist.shape[1]), hist, **{**OPTS, **kw})
+
+
+def _standing(point, L):
+    """A synthetic history: the same state at every section (L, 1, 2)."""
+    return np.tile(np.asarray(point, dtype=float), (L, 1, 1))
+
+
+def test_find_orbits_reports_the_orbits_runs_reach_with_their_period_turns_and_multipliers():
+    # rows: 0 a fixed point (multipliers 0.5 heading, 0.25 x); 1 the same slipping a turn a period;
+    # 2 a 2-cycle x = +-0.3 (multipliers of P^2: 0.6^2 heading, 0.5^2 x); 3 a slipping fixed point
+    # the run alternates around (x' = -0.9 x): only lag 2 repeats, so it is found through P^2;
+    # 4 an attracting fixed point the run stands 0.01 away from (not reached); 5 no repeat at all
+    pm = ToyMap(s=[0, 1, 0, 1, 0, 0], a=[0.5, 0.5, 0.6, 0.5, 0.5, 0.5], b=[0.25, 0.25, 0.5, -0.9, 0.25, 0.25],
+                mode=[1, 1, 2, 1, 1, 1], phi0=[0.3, 0.3, -0.4, 0.3, 0.3, 0.3])
+    L = 13
+    runs = pm.run([[0.01, 0.31], [0.01, 0.31], [0.31, -0.39], [2e-3 / 0.9 ** 11, 0.301], [0, 0], [0, 0]], L)
+    runs[:, 4] = [0.01, 0.3]                                          # standing still, off the orbit
+    runs[:, 5] = np.column_stack([0.1 * np.arange(L), np.full(L, 0.3)])   # drifting away
+    before = runs.copy()
+    out = _find(pm, runs)
+    assert np.array_equal(runs, before)                              # the history is not changed
+    assert out["found"].tolist() == [True, True, True, True, False, False]
+    assert out["status"].tolist() == ["found"] * 4 + ["not reached", ""]
+    assert out["k"].tolist() == [1, 1, 2, 1, 0, 0] and out["lag"].tolist() == [1, 1, 2, 2, 0, 0]
+    assert out["n"].tolist() == [0, 1, 0, 1, 0, 0]
+    assert all(out[f].dtype.kind == "i" for f in ("k", "lag", "n"))
+    # rho: the largest |multiplier| of P^k for the least period k, |mu_1(P^lag)|^(k / lag)
+    np.testing.assert_allclose(out["rho"][:4], [0.5, 0.5, 0.36, 0.9], rtol=1e-15, atol=0)  # measured 0
+    np.testing.assert_allclose(out["floquet"][:5], [0.5, 0.5, 0.36, 0.81, 0.5], rtol=1e-15, atol=0)  # measured 0
+    np.testing.assert_allclose(np.abs(out["mult"][:4]), [[0.5, 0.25], [0.5, 0.25], [0.36, 0.25], [0.81, 0.25]],
+                               rtol=1e-15, atol=0)  # measured 0
+    # the orbit point Newton found from the last state (the 2-cycle's point near it: +0.3)
+    np.testing.assert_allclose(out["x"][:4, 0], [0, 0, 0.3, 0], rtol=0, atol=1e-16)  # measured 1.1e-18
+    np.testing.assert_allclose(dv.wrap_angle(out["x"][:4, 1] - [0.3, 0.3, -0.4, 0.3]), 0, rtol=0,
+                               atol=3e-13)  # measured 2.5e-14 (a heading 24 pi out)
+    assert np.all(out["residual"][:4] <= 1e-12)   # reason: Newton's stopping tolerance (OPTS)
+    # the distance of the last state to the orbit (the heading modulo whole turns), and the
+    # orbit point it is nearest to
+    orbit = np.array([[0, 0.3], [0, 0.3], [0.3, -0.4], [0, 0.3]])
+    dd = runs[-1, :4] - orbit
+    dd[:, 1] = dv.wrap_angle(dd[:, 1])
+    np.testing.assert_allclose(out["distance"][:4], np.abs(dd).max(axis=1), rtol=1e-8, atol=0)  # measured 1.5e-9
+    assert out["distance"][3] > 1e-3              # reason: the alternating run is still 1.8e-3 away (0.9^12)
+    np.testing.assert_allclose(out["near"][:4, 0], orbit[:, 0], rtol=0, atol=1e-16)  # measured 9.8e-19
+    np.testing.assert_allclose(dv.wrap_angle(out["near"][:4, 1] - orbit[:, 1]), 0, rtol=0,
+                               atol=4e-14)  # measured 3.6e-15
+    # rows without an orbit: every orbit field NaN, nothing left over from an attempt
+    for f in ("rho", "x", "mult", "residual", "distance", "near"):
+        assert np.isnan(out[f][4:]).all(), f
+    assert np.isnan(out["floquet"][5])
+
+
+def test_find_orbits_says_why_an_orbit_does_not_count_and_goes_on_to_longer_periods():
+    # 0 a repelling fixed point (x' = 1.5 x) the run sits on; 1 a 2-cycle (found at lag 2 after
+    # lag 1 gave nothing attracting); 2 no fixed point (Newton does not converge); 3 a neutral
+    # heading (a = 1: |mu_1| = 1 exactly) is not attracting
+    pm = ToyMap(a=[0.5, 0.6, 0.5, 1.0], b=[1.5, 0.5, 0.25, 0.25], mode=[1, 2, 3, 1], phi0=[0.3, -0.4, 0.3, 0.3])
+    L = 13
+    runs = pm.run([[0, 0.3], [0.31, -0.39], [1.0, 0.3], [0, 0.7]], L)
+    out = _find(pm, runs)
+    assert out["status"].tolist() == ["not attracting", "found", "not converged", "not attracting"]
+    assert out["found"].tolist() == [False, True, False, False] and out["k"][1] == 2
+    # floquet: the last attempt's, lag 4 for the repelling point (tried at every lag)
+    np.testing.assert_allclose(out["floquet"][[0, 3]], [1.5 ** 4, 1.0], rtol=1e-15, atol=0)  # measured 0
+    assert np.isnan(out["floquet"][2])
+
+
+def test_find_orbits_takes_the_earlier_distance_max_period_doubled_or_the_history_back():
+    # the approach is judged from the state M = min(L - 1, 2 max_period) periods back (k = 1): the
+    # runs stand 0.01 from the orbit, except one earlier state 2 pi away. Row 0: 2 pi in x (not an
+    # angle); row 1: 2 pi in a heading that is a plain coordinate (turns False). Found exactly when
+    # that state is the one M periods back.
+    pm = ToyMap(b=0.9, phi0=0.3, angle=[True, False])
+    for L in (6, 12):
+        M = min(L - 1, 2 * OPTS["max_period"])
+        for shift in (0, 1, -1):
+            if M + 1 - shift > L:
+                continue
+            runs = np.tile([[0.01, 0.3], [0.01, 0.3]], (L, 1, 1))
+            runs[-1 - M + shift] += [[TWO_PI, 0], [0, TWO_PI]]
+            out = _find(pm, runs, turns=[True, False])
+            assert out["found"].tolist() == [shift == 0] * 2, (L, shift)
+            assert out["status"].tolist() == ["found" if shift == 0 else "not reached"] * 2
+
+
+def test_find_orbits_on_a_short_history_and_max_period():
+    # a 2-cycle from four sections: lag 2 at max_period 2, the earlier state two periods back
+    pm = ToyMap(a=0.6, b=0.5, mode=2, phi0=-0.4)
+    runs = pm.run([[0.3 + 1e-4, -0.4]], 4)
+    out = _find(pm, runs, max_period=2)
+    assert out["status"].tolist() == ["found"] and (out["k"][0], out["lag"][0]) == (2, 2)
+
+
+def test_find_orbits_does_not_count_a_run_standing_off_its_orbit_by_a_whole_turn_in_a_plain_coordinate():
+    # standing 2 pi from the orbit in x (row 0) or in a heading that is no angle (row 1, turns
+    # False): far, not on it; row 2, the same in an angle heading, is on it
+    pm = ToyMap(b=0.5, phi0=0.3, angle=[True, False, True])
+    runs = np.tile([[TWO_PI, 0.3], [0, 0.3 + TWO_PI], [0, 0.3 + TWO_PI]], (8, 1, 1))
+    out = _find(pm, runs, turns=[True, False, True], newton_options=dict(max_iter=20, max_step=10.0))
+    assert out["status"].tolist() == ["not reached", "not reached", "found"]
+
+
+def test_find_orbits_keeps_the_turns_the_history_shows_unless_told_otherwise():
+    # the history gains a turn a period, the map does not slip: with the candidate's turns
+    # (the default) there is no orbit; with free turns Newton finds the fixed point, n = 0
+    pm = ToyMap(phi0=0.3)
+    runs = np.stack([np.zeros(12), 0.3 + TWO_PI * np.arange(12)], axis=-1)[:, None]
+    assert _find(pm, runs)["status"].tolist() == ["not converged"]
+    out = _find(pm, runs, fixed_turns=False)
+    assert out["status"].tolist() == ["found"] and (out["k"][0], out["n"][0]) == (1, 0)
+
+
+def test_find_orbits_slips_only_where_turns_allow_it():
+    pm = ToyMap(s=1)
+    runs = pm.run([[0.01, 0.31], [0.01, 0.31]], 12)
+    out = _find(pm, runs, turns=[True, False])
+    assert out["status"].tolist() == ["found", ""] and out["n"][0] == 1
+
+
+def test_find_orbits_needs_ends_repeating_states():
+    # the section repeats exactly at the orbit but for the fourth state from the end: two
+    # repeating ends (the default) find it; three do not (max_period 3: no lag avoids that state)
+    pm = ToyMap()
+    runs = _standing([0, 0.3], 8)
+    runs[-4] = [0.5, 0.3]
+    assert _find(pm, runs, max_period=3)["status"].tolist() == ["found"]
+    assert _find(pm, runs, max_period=3, ends=3)["status"].tolist() == [""]
+
+
+def test_find_orbits_counts_a_residual_at_newton_tol_as_converged():
+    # x' = x / 2 from x = 2^-20, the heading on its fixed point, no Newton step: the residual is
+    # 2^-21 exactly, equal to the tolerance
+    pm = ToyMap(b=0.5)
+    out = _find(pm, _standing([2.0 ** -20, 0.3], 8), newton_tol=2.0 ** -21, reach_floor=1e-6,
+                newton_options=dict(max_iter=0))
+    assert out["status"].tolist() == ["found"] and out["residual"][0] == 2.0 ** -21
+
+
+def test_find_orbits_tries_a_lag_again_only_once_its_defect_has_halved():
+    # 0 a run reaching a fixed point (found at lag 1), 1 a run standing off one (not reached: its
+    # multiples wait), 2 a run that never repeats
+    pm = ToyMap()
+    L = 13
+    runs = pm.run([[0.01, 0.31], [0, 0], [0, 0]], L)
+    runs[:, 1] = [0.01, 0.3]
+    runs[:, 2] = np.column_stack([0.1 * np.arange(L), np.full(L, 0.3)])
+    tried = np.full((4, 3), np.inf)
+    out = _find(pm, runs, tried=tried)
+    assert out["status"].tolist() == ["found", "not reached", ""]
+    d0 = max(np.abs(runs[-1, 0] - runs[-2, 0]).max(), np.abs(runs[-2, 0] - runs[-3, 0]).max())
+    assert tried[0].tolist() == [d0, 0.0, np.inf]                    # the lag-1 defect Newton ran at
+    assert np.isinf(tried[1:]).all()                                  # no other lag was tried
+    # the same history again (lag 1 only): the defect has not halved, so nothing is tried
+    again = _find(pm, runs, tried=tried[:1], max_period=1)
+    assert again["status"].tolist() == ["", "", ""]
+    tried[0, 0] = 2 * d0 * (1 + 1e-12)                              # just over twice the defect: tried again
+    assert _find(pm, runs, tried=tried[:1], max_period=1)["status"].tolist() == ["found", "", ""]
+
+
+def test_find_orbits_waits_on_the_multiples_of_an_orbit_not_yet_reached():
+    # a 2-cycle the run stands off (0.01 from both points): tried at lag 2 only, not at 4 (its
+    # multiple), so the multiplier reported is that of P^2
+    pm = ToyMap(a=0.6, b=0.5, mode=2, phi0=-0.4)
+    runs = np.array([[0.31, -0.4], [-0.31, -0.4]] * 6)[:, None]
+    tried = np.full((4, 1), np.inf)
+    out = _find(pm, runs, tried=tried)
+    assert out["status"].tolist() == ["not reached"]
+    np.testing.assert_allclose(out["floquet"], [0.36], rtol=1e-15, atol=0)  # measured 0
+    assert tried[:, 0].tolist() == [np.inf, 0.0, np.inf, np.inf]
+
+
+def test_lag_candidates_at_their_boundaries():
+    # (L, N, d) = (6, 3, 2), heading column 1. Row 0 repeats but for the fourth state from the
+    # end; row 1 but for the third (one return is not enough); row 2 gains a turn in its last
+    # period and x alternates by 0.5 (= tol: a repeat)
+    hist = np.zeros((6, 3, 2))
+    hist[-4, 0, 0] = 1.0
+    hist[-3, 1, 0] = 1.0
+    hist[-1, 2, 1] = TWO_PI
+    hist[::2, 2, 0] = 0.5
+    ok, n, defect = dv.lag_candidates(hist, 6, 0.5, turn_axis=1)
+    assert ok[0].tolist() == [True, False, True]
+    assert defect[0].tolist() == [0.0, 1.0, 0.5]
+    assert n[0].tolist() == [0, 0, 1] and n.dtype.kind == "i"        # turns between the last two
+    assert not ok[4:].any() and np.isinf(defect[4:]).all()           # lags beyond L - ends
+    ok3, _, _ = dv.lag_candidates(hist, 6, 0.5, turn_axis=1, ends=3)
+    assert ok3[0].tolist() == [False, False, True]
+    # whole numbers are states too
+    ints = np.arange(24).reshape(6, 2, 2) % 3
+    for a, b in zip(dv.lag_candidates(ints, 3, 0.5, turn_axis=1), dv.lag_candidates(ints * 1.0, 3, 0.5, turn_axis=1)):
+        assert np.array_equal(a, b)
+
+
+def test_least_period_at_its_boundaries():
+    # row 0: a 2-cycle found at lag 4 is of period 2; row 1: period 4; row 2: P^2(x) - x = 0.25 =
+    # tol exactly (a repeat), P(x) - x = 0.5 (not)
+    x = np.array([[0.3, 0.0], [0.0, 0.0], [0.0, 0.0]])
+    pts = np.array([[[-0.3, 0.0], [1.0, 0.0], [0.5, 0.0]], [[0.3, 0.0], [2.0, 0.0], [0.25, 0.0]],
+                    [[-0.3, 0.0], [3.0, 0.0], [0.5, 0.0]], [[0.3, 0.0], [0.0, 0.0], [0.0, 0.0]]])
+    k, n = dv.least_period(x, pts, np.array([4, 4, 4]), np.array([0, 0, 0]), turn_axis=1, tol=0.25)
+    assert k.tolist() == [2, 4, 2] and n.tolist() == [0, 0, 0]
+    k, n = dv.least_period(np.zeros((0, 2)), np.zeros((1, 0, 2)), np.zeros(0, int), np.zeros(0, int),
+                           turn_axis=1, tol=0.25)
+    assert k.size == 0 and n.size == 0
+
+
+def test_distance_to_orbit_wraps_only_the_heading_and_only_where_turns_allow():
+    # heading column 1; orbit points (K, M, d) = (3, 2, 2), row 0 has only two (NaN past k)
+    pts = np.array([[[0.0, 0.5], [5.0, 0.0]], [[1.0, 0.0], [5.0, 1.0]], [[np.nan, np.nan], [0.5, 0.0]]])
+    state = np.array([[1.0, TWO_PI + 0.125], [0.25, 0.0]])
+    d, j = dv.distance_to_orbit(state, pts, turn_axis=1)                  # turns allowed by default
+    np.testing.assert_allclose(d, [0.125, 0.25], rtol=1e-15, atol=0)  # measured 0 (2 pi + 0.125 wrapped)
+    assert j.tolist() == [1, 2]
+    d, j = dv.distance_to_orbit(state, pts, turn_axis=1, turns=[False, True])
+    np.testing.assert_allclose(d, [TWO_PI - 0.375, 0.25], rtol=1e-15, atol=0)  # measured 0
+    assert j.tolist() == [0, 2]
+
+
+def test_reached_at_its_boundaries():
+    # binary-exact numbers: 3 d_then rho^r + floor = 3 * 0.25 * 0.25 + 2^-10
+    floor = 2.0 ** -10
+    bound = 3 * 0.25 * 0.25 + floor
+    got = dv.reached([bound, 0.2, 0.01, floor, 0.125], [0.25, 0.25, 0.01, floor, 1.0],
+                     [0.25, 0.25, 0.999, 0.999, 0.25], 1, tol=0.125, floor=floor)
+    # on the rate bound: reached; above it (but below 4x): not; standing still above the floor:
+    # not; standing on the floor: reached; at tol exactly and shrinking: reached
+    assert got.tolist() == [False, False, False, True, True]
+    got = dv.reached([bound], [0.25], [0.25], 1, tol=0.5, floor=floor)
+    assert got.tolist() == [True]
+
+
+def test_orbit_points_stop_at_each_rows_period():
+    # x' = x / 2, the heading on its fixed point 0 gaining s turns a period; a start in whole numbers
+    pm = ToyMap(s=[0, 1], b=0.5, phi0=0.0)
+    pts = dv.orbit_points(pm, np.arange(2), np.array([[3, 0], [3, 0]]), [1, 2])
+    assert pts.shape == (2, 2, 2)
+    np.testing.assert_array_equal(pts[0], [[1.5, 0.0], [1.5, TWO_PI]])
+    assert np.isnan(pts[1, 0]).all()
+    np.testing.assert_allclose(pts[1, 1], [0.75, 2 * TWO_PI], rtol=1e-15, atol=0)  # measured 0
+
+
+def test_section_returns_of_a_standing_run_a_short_one_and_a_one_dimensional_one():
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")                             # no 0 / 0 warning either
+        assert dv.section_returns(np.ones((10, 1, 2))).tolist() == [np.inf]
+    # a 2-cycle over six sections (the shortest run judged) comes back exactly
+    two = np.zeros((6, 1, 2))
+    two[1::2, 0, 1] = 1.0
+    assert dv.section_returns(two).tolist() == [0.0]
+    assert dv.section_returns(two[:5]).tolist() == [np.inf]
+    # a heading alone, rotating by an irrational angle: it fills the circle
+    k = np.arange(400)[:, None, None]
+    r = dv.section_returns(dv.wrap_angle(k * 2 * np.pi * (np.sqrt(5) - 1) / 2), angles=(0,))
+    assert r[0] < 0.05                         # reason: the flows' return_tol; measured 1.9e-3
+
+
+def test_section_returns_are_per_run_invariant_under_scale_and_heading_shift():
+    L = 400
+    k = np.arange(L)[:, None]
+    line = np.stack([-1 + 1.5 * 0.995 ** k, 0.5 * 0.995 ** k], axis=2)       # a slow approach (L, 1, 2)
+    ring = np.stack([0.3 * np.cos(k * 2.4), 0.3 * np.sin(k * 2.4)], axis=2)  # a closed curve
+    alone = [dv.section_returns(line)[0], dv.section_returns(ring)[0]]
+    assert dv.section_returns(np.concatenate([line, 2 * ring], axis=1)).tolist() == alone
+    assert 0.25 <= alone[0] < np.inf                           # reason: moves away for good (at least leave)
+    # only the angle columns wrap: x steadily drifting over 20 (more than 2 pi) never comes back
+    drift = np.stack([np.zeros((L, 1)), 0.05 * k], axis=2)
+    assert dv.section_returns(drift, angles=(0,))[0] >= 0.25   # reason: moves away for good
+    # the first state is a reference: a start off a closed curve that never comes back near it
+    start = ring.copy()
+    start[0] = [2.0, 0.0]
+    assert dv.section_returns(start, angles=())[0] > 0.25      # reason: by construction; measured 0.74
+    # a scale of all the (non-angle) columns, a shift of the heading (column 0): the same result
+    assert dv.section_returns(4 * line, angles=())[0] == dv.section_returns(line, angles=())[0]
+    for c in (1.0, np.pi / 2, -2.0, 3.0):
+        np.testing.assert_allclose(dv.section_returns(line + [c, 0.0])[0], alone[0], rtol=1e-15,
+                                   atol=0)  # measured 0
+    ints = (np.arange(40).reshape(20, 1, 2) * 3) % 7
+    assert dv.section_returns(ints).tolist() == dv.section_returns(ints * 1.0).tolist()
+
+
+def test_enclosed_orbit_starts_newton_at_the_circular_mean_of_each_curve():
+    # with no Newton step allowed, the curve's centre must already be the fixed point: row 0 a
+    # slipping orbit with its heading at pi (the curve crosses the wrap), row 1 one at 0.5;
+    # multipliers 0.5 (heading) and 0.25 (x), 0.5 and 0.8
+    pm = ToyMap(s=[1, 0], b=[0.25, 0.8], phi0=[np.pi, 0.5])
+    t = np.linspace(0, 2 * np.pi, 40, endpoint=False)[:, None]
+    sec = np.stack([0.2 * np.cos(t) + [0.0, 0.0], 0.2 * np.sin(t) + [np.pi, 0.5]], axis=2)
+    sec[:, :, 1] = dv.wrap_angle(sec[:, :, 1])
+    att, mu = dv.enclosed_orbit(pm.step, np.arange(2), sec, turn_axis=1, newton_tol=1e-12,
+                                newton_options=dict(max_iter=0))
+    assert att.tolist() == [True, True]
+    np.testing.assert_allclose(mu, [0.5, 0.8], rtol=1e-15, atol=0)  # measured 0
+    # a neutral heading (a = 1), x symmetric about its fixed point: the residual is 0 = tol
+    # exactly; |mu_1| = 1 is not attracting
+    pm = ToyMap(a=1.0)
+    sec = np.array([[0.25, 0.1], [-0.25, 0.2]] * 4)[:, None]
+    att, mu = dv.enclosed_orbit(pm.step, np.arange(1), sec, turn_axis=1, newton_tol=0.0,
+                                newton_options=dict(max_iter=0))
+    assert att.tolist() == [False] and mu.tolist() == [1.0]
+
+
+def test_held_orbit_regime_and_turns_round_on_their_own_terms():
+    # held: flags given as 0 / 1 floats (a frame's column) read as booleans, the answer a bool array
+    got = dv.held(["periodic", "periodic", "periodic"], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0])
+    assert got.dtype == bool and got.tolist() == [True, False, False]
+    assert dv.orbit_regime([0, 1, -2]).tolist() == ["periodic", "slipping", "slipping"]
+    assert dv.turns_round([TWO_PI, np.nextafter(TWO_PI, 7)]).tolist() == [False, True]
+
+
+def test_drift_is_per_period_in_the_units_of_the_samples_by_default():
+    drift, se = dv.drift_statistics([[0.0, 3.0, 6.0, 9.0]], 3)
+    assert drift.tolist() == [1.0] and se.tolist() == [0.0]
