@@ -288,7 +288,12 @@ def _english_none(text: str, start: int, end: int) -> bool:
     return (not before or before[-1] in ".!?\n") and re.match(r" [a-z]", text[end:]) is not None
 
 
-@pytest.mark.parametrize("doc", DOCS)
+#: pages generated from the library's docstrings (reference.md): None and NaN there are
+#: words of the API (defaults, return values), not missing values; they glue nothing
+API_DOCS = ("reference",)
+
+
+@pytest.mark.parametrize("doc", [d for d in DOCS if d not in API_DOCS])
 def test_no_raw_glue_nan_or_none_in_the_prose(doc, pages):
     text = _page(pages, doc).data["prose"]
     found = []
