@@ -22,7 +22,7 @@ ROOT = Path(__file__).resolve().parents[1]
 # What the book is built from: a build of _build/ older than any of these is stale.
 # (README.md is not part of the book: _config.yml excludes it.)
 BOOK_INPUTS = ("chapters/*.md", "*.md", "_config.yml", "_toc.yml", "references.bib",
-               "lib/**/*.py", "_static/*", "requirements.txt")
+               "lib/**/*.py", "_static/*", "_ext/*.py", "requirements.txt")
 BUILD_CMD = ["build", "--all", "-W", "-n", "--keep-going", "."]
 
 
