@@ -445,17 +445,18 @@ def test_find_orbits_takes_the_earlier_distance_max_period_doubled_or_the_histor
     # runs stand 0.01 from the orbit, except one earlier state 2 pi away. Row 0: 2 pi in x (not an
     # angle); row 1: 2 pi in a heading that is a plain coordinate (turns False). Found exactly when
     # that state is the one M periods back.
-    pm = ToyMap(b=0.9, phi0=0.3, angle=[True, False])
+    # Row 2: a whole turn in an angle heading is the same state: never found.
+    pm = ToyMap(b=0.9, phi0=0.3, angle=[True, False, True])
     for L in (6, 12):
         M = min(L - 1, 2 * OPTS["max_period"])
         for shift in (0, 1, -1):
             if M + 1 - shift > L:
                 continue
-            runs = np.tile([[0.01, 0.3], [0.01, 0.3]], (L, 1, 1))
-            runs[-1 - M + shift] += [[TWO_PI, 0], [0, TWO_PI]]
-            out = _find(pm, runs, turns=[True, False])
-            assert out["found"].tolist() == [shift == 0] * 2, (L, shift)
-            assert out["status"].tolist() == ["found" if shift == 0 else "not reached"] * 2
+            runs = np.tile([[0.01, 0.3]] * 3, (L, 1, 1))
+            runs[-1 - M + shift] += [[TWO_PI, 0], [0, TWO_PI], [0, TWO_PI]]
+            out = _find(pm, runs, turns=[True, False, True])
+            assert out["found"].tolist() == [shift == 0] * 2 + [False], (L, shift)
+            assert out["status"].tolist() == ["found" if shift == 0 else "not reached"] * 2 + ["not reached"]
 
 
 def test_find_orbits_on_a_short_history_and_max_period():
@@ -595,13 +596,14 @@ def test_reached_at_its_boundaries():
     # binary-exact numbers: 3 d_then rho^r + floor = 3 * 0.25 * 0.25 + 2^-10
     floor = 2.0 ** -10
     bound = 3 * 0.25 * 0.25 + floor
-    got = dv.reached([bound, 0.2, 0.01, floor, 0.125], [0.25, 0.25, 0.01, floor, 1.0],
-                     [0.25, 0.25, 0.999, 0.999, 0.25], 1, tol=0.125, floor=floor)
-    # on the rate bound: reached; above it (but below 4x): not; standing still above the floor:
-    # not; standing on the floor: reached; at tol exactly and shrinking: reached
-    assert got.tolist() == [False, False, False, True, True]
-    got = dv.reached([bound], [0.25], [0.25], 1, tol=0.5, floor=floor)
-    assert got.tolist() == [True]
+    got = dv.reached([bound, 0.01, floor, 0.125], [0.25, 0.01, floor, 1.0], [0.25, 0.999, 0.999, 0.25], 1,
+                     tol=0.125, floor=floor)
+    # beyond tol, however fast; standing still above the floor: not; standing on the floor:
+    # reached; at tol exactly and shrinking: reached
+    assert got.tolist() == [False, False, True, True]
+    # on the rate bound: reached; above it (0.2: 3.2 d_then rho^r, within 4x): not
+    got = dv.reached([bound, 0.2], [0.25, 0.25], [0.25, 0.25], 1, tol=0.5, floor=floor)
+    assert got.tolist() == [True, False]
 
 
 def test_orbit_points_stop_at_each_rows_period():
@@ -644,15 +646,23 @@ def test_section_returns_are_per_run_invariant_under_scale_and_heading_shift():
     assert dv.section_returns(drift, angles=(0,))[0] >= 0.25   # reason: moves away for good
     # the first state is a reference: a start off a closed curve that never comes back near it
     start = ring.copy()
-    start[0] = [2.0, 0.0]
-    assert dv.section_returns(start, angles=())[0] > 0.25      # reason: by construction; measured 0.74
+    start[0] = [0.6, 0.0]                                      # 0.3 from the curve, D = 0.9
+    assert 0.25 < dv.section_returns(start, angles=())[0] < np.inf   # reason: by construction; measured 0.33
     # a scale of all the (non-angle) columns, a shift of the heading (column 0): the same result
     assert dv.section_returns(4 * line, angles=())[0] == dv.section_returns(line, angles=())[0]
     for c in (1.0, np.pi / 2, -2.0, 3.0):
         np.testing.assert_allclose(dv.section_returns(line + [c, 0.0])[0], alone[0], rtol=1e-15,
                                    atol=0)  # measured 0
-    ints = (np.arange(40).reshape(20, 1, 2) * 3) % 7
+    # whole numbers are states too: a heading advancing 1 rad a period, given as integers
+    ints = np.stack([np.arange(40), np.zeros(40, int)], axis=-1)[:, None]
     assert dv.section_returns(ints).tolist() == dv.section_returns(ints * 1.0).tolist()
+
+
+def test_a_state_exactly_leave_times_the_diameter_away_has_not_left():
+    # D = 1: the second state, 0.25 = leave D from the first, has not left; the first to leave
+    # is 0.5 away, and nothing comes back nearer (the reference at L // 3 = 2 returns exactly)
+    x = np.array([0.0, 0.25, 0.5, 1.0, 0.5, 0.5])[:, None, None]
+    assert dv.section_returns(x, angles=()).tolist() == [0.5]
 
 
 def test_enclosed_orbit_starts_newton_at_the_circular_mean_of_each_curve():
@@ -687,3 +697,19 @@ def test_held_orbit_regime_and_turns_round_on_their_own_terms():
 def test_drift_is_per_period_in_the_units_of_the_samples_by_default():
     drift, se = dv.drift_statistics([[0.0, 3.0, 6.0, 9.0]], 3)
     assert drift.tolist() == [1.0] and se.tolist() == [0.0]
+
+
+class SwappedToy(ToyMap):
+    """The toy map with column 0 (x) taken as the heading."""
+
+    turn_axis = 0
+
+
+def test_a_two_cycle_a_whole_turn_apart_is_of_period_two_in_a_plain_coordinate():
+    # x' = -h(x) has the 2-cycle +-pi (q = pi), its points 2 pi apart. Where the heading column is
+    # a plain coordinate (turns False) it is a 2-cycle, not reduced to a fixed point by a whole turn
+    pm = SwappedToy(b=0.5, mode=2, q=np.pi)
+    runs = pm.run([[np.pi + 1e-3, 0.3]], 13)
+    out = _find(pm, runs, turns=False)
+    assert out["status"].tolist() == ["found"]
+    assert (out["k"][0], out["n"][0], out["lag"][0]) == (2, 0, 2)
