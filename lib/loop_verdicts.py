@@ -27,7 +27,7 @@ from .parallel import concat_frames, map_chunks
 from .params import Body, Gains
 from .trajectories import KINEMATICS
 
-__all__ = ["LOOP_VERDICT_DEFAULTS", "closed_loop_verdicts", "held"]
+__all__ = ["LOOP_VERDICT_DEFAULTS", "closed_loop_verdicts"]
 
 
 def _points(R, Theta, weights):
@@ -486,23 +486,3 @@ def _decide(flow: _PeriodFlow, obs: dict, turns, o) -> dict:
     out["lost"][bad] = out["position_lost"][bad] = True
     out["tracked"] = ~out["position_lost"] & (acc["posmax"] <= o["position_tol"] * flow.R)
     return out
-
-
-def held(frame: pd.DataFrame) -> np.ndarray:
-    """(N,) bool, the book's one definition of "held" (:func:`lib.dynamics.verdicts.held`):
-    the closed loop reaches an attracting periodic orbit (verdict ``periodic``), the heading is
-    not lost, and the position is tracked (column ``tracked`` of :func:`closed_loop_verdicts`).
-
-    Parameters
-    ----------
-    frame : pandas.DataFrame
-        A frame of :func:`closed_loop_verdicts`.
-
-    Returns
-    -------
-    numpy.ndarray
-        One bool per row.
-    """
-    return dv.held(frame.regime.to_numpy(), frame.lost.to_numpy(), frame.tracked.to_numpy())
-
-

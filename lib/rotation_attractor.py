@@ -13,13 +13,14 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import CubicSpline
 
+from . import checks
 from .angles import wrap_angle
 from .dynamics.verdicts import REGIMES, orbit_points
 from .params import Body
 from .rotation import _check_grid, _shape
 from .rotation_engine import RotationMap, _Engine
 from .rotation_field import coefficients
-from .rotation_verdicts import (SLOW_FLOQUET, _check_body_kind, _check_pos, _step_counts, _verdict_core,
+from .rotation_verdicts import (SLOW_FLOQUET, _check_body_kind, _step_counts, _verdict_core,
                                 _verdict_options)
 
 __all__ = ["RotationAttractor", "rotation_attractor", "MapSummary", "map_summary"]
@@ -116,7 +117,7 @@ def rotation_attractor(body: Body, kind: str, R: float, Theta: float, *, p0: flo
     if not (np.isfinite(p0) and np.isfinite(v0)):
         raise ValueError("initial p0 and v0 must be finite")
     _check_body_kind(body, kind)
-    h_lambda = _check_pos("h_lambda", h_lambda)
+    h_lambda = checks.number("h_lambda", h_lambda, positive=True)
     opts = _verdict_options(options)
     n_pts, n_fine = _step_counts(body, kind, R_, Th, h_lambda, steps, opts)
     n = int(n_fine[0])

@@ -39,11 +39,8 @@ section_returns = dv.section_returns
 
 def eight_rotation_sweep(body: Body, R, Theta, **options) -> pd.DataFrame:
     """Fig. 5: the verdict on the rotation error on the eight (28) and its steady-state
-    range, started on the reference, for each pair (R_i (m), Theta_i (rad/s)): periodic,
-    slipping, chaotic, quasiperiodic or undecided, decided by :func:`rotation_verdicts`
-    (Newton on the period map of (32) and the largest Lyapunov exponent). See there for
-    the options and the columns (including ``lost``), and for ``executor`` and ``chunk_size``
-    (the points in chunks through any :class:`concurrent.futures.Executor`) and ``progress``.
+    range, started on the reference, for each pair (R_i (m), Theta_i (rad/s)), decided by
+    :func:`rotation_verdicts` (see there for the options, the columns and ``executor``).
 
     Parameters
     ----------
@@ -71,8 +68,7 @@ FIG5_GRID = MappingProxyType(dict(R=(0.25, 4.0), Theta=(0.05, 1.5), n=100))
 def fig5_map(body: Body, n: int = FIG5_GRID["n"], *, executor=None, chunk_size: int | None = None,
              progress: bool | None = None) -> pd.DataFrame:
     """The book's Fig. 5 (Chapter 5, and the report's row on it): :func:`eight_rotation_sweep`
-    on the n x n grid :data:`FIG5_GRID`, Theta varying slowest; ``executor``, ``chunk_size``
-    and ``progress`` as there (the same frame, computed elsewhere in chunks).
+    on the n x n grid :data:`FIG5_GRID`, Theta varying slowest.
 
     Parameters
     ----------
@@ -88,7 +84,7 @@ def fig5_map(body: Body, n: int = FIG5_GRID["n"], *, executor=None, chunk_size: 
     pandas.DataFrame
         The frame of :func:`rotation_verdicts`, n^2 rows.
     """
-    n = _check_int("n", n, 2)
+    n = checks.integer("n", n, minimum=2)
     R, Th = np.meshgrid(np.linspace(*FIG5_GRID["R"], n), np.linspace(*FIG5_GRID["Theta"], n))
     return eight_rotation_sweep(body, R.ravel(), Th.ravel(), executor=executor, chunk_size=chunk_size,
                                 progress=progress)
@@ -97,14 +93,6 @@ def fig5_map(body: Body, n: int = FIG5_GRID["n"], *, executor=None, chunk_size: 
 def _check_body_kind(body, kind):
     checks.one_of("kind", kind, ("eight", "circle"))
     checks.instance("body", body, Body)
-
-
-def _check_int(name, v, lo):
-    return checks.integer(name, v, minimum=lo)
-
-
-def _check_pos(name, v):
-    return checks.number(name, v, positive=True)
 
 
 _DEFAULTS = dict(transient=48, min_transient=8, chunk=8, max_period=8, lyapunov_periods=300, block=12,
@@ -125,15 +113,15 @@ def _verdict_options(options: dict) -> dict:
         raise TypeError(f"unknown option(s) {sorted(unknown)}; known: {sorted(set(_DEFAULTS) | {'max_periods'})}")
     o = dict(_DEFAULTS, **{k: v for k, v in options.items() if k != "max_periods"})
     for name in ("transient", "min_transient", "chunk", "lyapunov_periods", "min_lyapunov_periods"):
-        o[name] = _check_int(name, o[name], 0 if name in ("lyapunov_periods", "min_lyapunov_periods") else 1)
-    o["max_period"] = _check_int("max_period", o["max_period"], 1)
-    o["block"] = _check_int("block", o["block"], 2)
+        o[name] = checks.integer(name, o[name], minimum=0 if name in ("lyapunov_periods", "min_lyapunov_periods") else 1)
+    o["max_period"] = checks.integer("max_period", o["max_period"], minimum=1)
+    o["block"] = checks.integer("block", o["block"], minimum=2)
     for name in ("newton_tol", "candidate_tol", "reach_tol", "reach_floor", "lyapunov_band", "slip_band",
                  "h_verdict", "return_tol"):
-        o[name] = _check_pos(name, o[name])
+        o[name] = checks.number(name, o[name], positive=True)
     mp = options.get("max_periods")
     if mp is not None:  # a total budget of periods per point: the transient first
-        mp = _check_int("max_periods", mp, 2)
+        mp = checks.integer("max_periods", mp, minimum=2)
         o["transient"] = min(o["transient"], mp)
         o["min_transient"] = min(o["min_transient"], o["transient"])
         o["lyapunov_periods"] = min(o["lyapunov_periods"], mp - o["transient"])
@@ -248,7 +236,7 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
     _check_body_kind(body, kind)
     checks.one_of("engine", engine, sorted(ENGINES))
     R, Theta = _check_grid(R, Theta)
-    h_lambda = _check_pos("h_lambda", h_lambda)
+    h_lambda = checks.number("h_lambda", h_lambda, positive=True)
     opts = _verdict_options(options)
     N = R.size
     p0, v0 = checks.array("p0", p0), checks.array("v0", v0)
@@ -275,7 +263,7 @@ def _step_counts(body, kind, R, Theta, h_lambda, steps, opts):
     """Steps per period of the verdict map (h omega <= ``h_verdict``) and of the fine map
     (h omega <= ``h_lambda``) on which orbits are located and measured; ``steps`` fixes both."""
     if steps is not None:
-        n = np.full(R.size, _check_int("steps", steps, 8))
+        n = np.full(R.size, checks.integer("steps", steps, minimum=8))
         return n, n
     n_fine = verdict_steps(body, kind, R, Theta, h_lambda)
     return np.minimum(verdict_steps(body, kind, R, Theta, opts["h_verdict"]), n_fine), n_fine

@@ -46,6 +46,8 @@ TESTS = {
     # the one decision procedure behind every verdict (issue 22): its unit tests, which feed it
     # statistics and small maps with known answers (the flows' own tests run minutes per mutant)
     "dynamics.verdicts": ["tests/test_verdict_procedure.py"],
+    "dynamics.orbit_search": ["tests/test_verdict_procedure.py"],
+    "dynamics.statistics": ["tests/test_verdict_procedure.py"],
 }
 #: tests written to kill survivors: always run
 ALWAYS = ["tests/test_core_mutants.py"]

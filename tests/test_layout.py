@@ -110,3 +110,22 @@ def test_the_parser_sees_relative_and_local_imports():
     assert "lib.trajectories" in g["lib.integrators.switched"]     # from ..trajectories import
     assert "lib.paper.model_errata" in g["lib.paper.errata"]       # from . import model_errata
     assert ("lib.rotation", "lib.integrators.compiled") in local
+
+
+def test_modules_and_functions_stay_a_size_a_reader_can_hold():
+    # no module over 500 lines; no function over 100 lines of code (its docstring aside:
+    # the numpydoc Parameters and Returns are reading, not logic)
+    long_modules, long_functions = [], []
+    for path in sorted(LIB.rglob("*.py")):
+        text = path.read_text()
+        if text.count("\n") > 500:
+            long_modules.append((path.name, text.count("\n")))
+        for node in ast.walk(ast.parse(text)):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                body = node.body
+                doc = isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant) and len(body) > 1
+                first = body[1].lineno if doc else body[0].lineno
+                if node.end_lineno - first + 1 > 100:
+                    long_functions.append((path.name, node.name, node.end_lineno - first + 1))
+    assert not long_modules, long_modules
+    assert not long_functions, long_functions

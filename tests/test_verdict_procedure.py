@@ -8,6 +8,7 @@ import pandas as pd
 import pytest
 
 from lib import limits, loop_verdicts, rotation_verdicts, stability
+from lib.angles import wrap_angle
 from lib.circle_rotation import circle_critical_radius, circle_eigenvalues
 from lib.dynamics import verdicts as dv
 from lib.params import Body
@@ -406,18 +407,18 @@ def test_find_orbits_reports_the_orbits_runs_reach_with_their_period_turns_and_m
                                rtol=1e-15, atol=0)  # measured 0
     # the orbit point Newton found from the last state (the 2-cycle's point near it: +0.3)
     np.testing.assert_allclose(out["x"][:4, 0], [0, 0, 0.3, 0], rtol=0, atol=1e-16)  # measured 1.1e-18
-    np.testing.assert_allclose(dv.wrap_angle(out["x"][:4, 1] - [0.3, 0.3, -0.4, 0.3]), 0, rtol=0,
+    np.testing.assert_allclose(wrap_angle(out["x"][:4, 1] - [0.3, 0.3, -0.4, 0.3]), 0, rtol=0,
                                atol=3e-13)  # measured 2.5e-14 (a heading 24 pi out)
     assert np.all(out["residual"][:4] <= 1e-12)   # reason: Newton's stopping tolerance (OPTS)
     # the distance of the last state to the orbit (the heading modulo whole turns), and the
     # orbit point it is nearest to
     orbit = np.array([[0, 0.3], [0, 0.3], [0.3, -0.4], [0, 0.3]])
     dd = runs[-1, :4] - orbit
-    dd[:, 1] = dv.wrap_angle(dd[:, 1])
+    dd[:, 1] = wrap_angle(dd[:, 1])
     np.testing.assert_allclose(out["distance"][:4], np.abs(dd).max(axis=1), rtol=1e-8, atol=0)  # measured 1.5e-9
     assert out["distance"][3] > 1e-3              # reason: the alternating run is still 1.8e-3 away (0.9^12)
     np.testing.assert_allclose(out["near"][:4, 0], orbit[:, 0], rtol=0, atol=1e-16)  # measured 9.8e-19
-    np.testing.assert_allclose(dv.wrap_angle(out["near"][:4, 1] - orbit[:, 1]), 0, rtol=0,
+    np.testing.assert_allclose(wrap_angle(out["near"][:4, 1] - orbit[:, 1]), 0, rtol=0,
                                atol=4e-14)  # measured 3.6e-15
     # rows without an orbit: every orbit field NaN, nothing left over from an attempt
     for f in ("rho", "x", "mult", "residual", "distance", "near"):
@@ -629,7 +630,7 @@ def test_section_returns_of_a_standing_run_a_short_one_and_a_one_dimensional_one
     assert dv.section_returns(two[:5]).tolist() == [np.inf]
     # a heading alone, rotating by an irrational angle: it fills the circle
     k = np.arange(400)[:, None, None]
-    r = dv.section_returns(dv.wrap_angle(k * 2 * np.pi * (np.sqrt(5) - 1) / 2), angles=(0,))
+    r = dv.section_returns(wrap_angle(k * 2 * np.pi * (np.sqrt(5) - 1) / 2), angles=(0,))
     assert r[0] < 0.05                         # reason: the flows' return_tol; measured 1.9e-3
 
 
@@ -672,7 +673,7 @@ def test_enclosed_orbit_starts_newton_at_the_circular_mean_of_each_curve():
     pm = ToyMap(s=[1, 0], b=[0.25, 0.8], phi0=[np.pi, 0.5])
     t = np.linspace(0, 2 * np.pi, 40, endpoint=False)[:, None]
     sec = np.stack([0.2 * np.cos(t) + [0.0, 0.0], 0.2 * np.sin(t) + [np.pi, 0.5]], axis=2)
-    sec[:, :, 1] = dv.wrap_angle(sec[:, :, 1])
+    sec[:, :, 1] = wrap_angle(sec[:, :, 1])
     att, mu = dv.enclosed_orbit(pm.step, np.arange(2), sec, turn_axis=1, newton_tol=1e-12,
                                 newton_options=dict(max_iter=0))
     assert att.tolist() == [True, True]
