@@ -16,10 +16,16 @@ import hashlib
 import os
 import pickle
 import time
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
+
+try:
+    import fcntl
+except ImportError:  # not POSIX: no lock, a key may then be computed twice at once
+    fcntl = None
 
 __all__ = ["cached", "cached_timed", "cache_dir"]
 
@@ -119,14 +125,36 @@ def cached_timed(fn: Callable, *args, **kwargs) -> tuple[Any, float]:
         result = fn(*args, **kwargs)
         return result, time.perf_counter() - tic
     if path.is_file():
-        with path.open("rb") as fh:
-            return pickle.load(fh)
-    tic = time.perf_counter()
-    result = fn(*args, **kwargs)
-    out = (result, time.perf_counter() - tic)
+        return _load(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(f".{os.getpid()}.tmp")
-    with tmp.open("wb") as fh:
-        pickle.dump(out, fh)
-    tmp.replace(path)
+    # one computation per key at a time: a second process (another notebook, or the tests
+    # beside the book's build) waits for the first and reads its result
+    with _locked(path.with_suffix(".lock")):
+        if path.is_file():
+            return _load(path)
+        tic = time.perf_counter()
+        result = fn(*args, **kwargs)
+        out = (result, time.perf_counter() - tic)
+        tmp = path.with_suffix(f".{os.getpid()}.tmp")
+        with tmp.open("wb") as fh:
+            pickle.dump(out, fh)
+        tmp.replace(path)
     return out
+
+
+def _load(path: Path):
+    with path.open("rb") as fh:
+        return pickle.load(fh)
+
+
+@contextmanager
+def _locked(lock: Path):
+    """An exclusive advisory lock on ``lock`` (POSIX ``flock``; none where there is no fcntl)."""
+    with lock.open("a") as fh:
+        if fcntl is not None:
+            fcntl.flock(fh, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            if fcntl is not None:
+                fcntl.flock(fh, fcntl.LOCK_UN)

@@ -1,5 +1,8 @@
 """lib.book_cache: one computation shared by two pages of one build, never a stale one."""
 
+import time
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 import pytest
 
@@ -55,3 +58,17 @@ def test_outside_a_book_it_simply_computes(tmp_path, monkeypatch):
     assert len(CALLS) == 2 and not (tmp_path / "_build").exists()
     with pytest.raises(FileNotFoundError, match="no book"):
         book_cache.cache_dir()
+
+
+def _slow_square(x):
+    CALLS.append(1)
+    time.sleep(0.3)          # long enough for the second caller to arrive while it computes
+    return np.asarray(x) ** 2
+
+
+def test_two_callers_at_once_compute_the_key_once(book):
+    # the book's notebooks and the tests run at the same time and share the cache: the second
+    # caller of a key waits for the first instead of computing it again
+    with ThreadPoolExecutor(2) as ex:
+        a, b = ex.map(lambda _: book_cache.cached(_slow_square, np.arange(3.0)), range(2))
+    assert len(CALLS) == 1 and np.array_equal(a, b)
