@@ -27,6 +27,9 @@ book: $(STAMP)
 # The book's build runs in the background (as `make book` runs it, its output in _build/book.out)
 # while the other tests run on two workers (pytest-xdist); then the build and browser tests read
 # that build. A current build left by `make book` is reused instead (tests/conftest.py).
+# The build is the longest path: the workers run niced and single-threaded (numba, OpenMP,
+# BLAS), so that three processes do not oversubscribe two cores (measured: 5 min 46 s instead
+# of 6 min 17 s, 10.4 instead of 11.6 min of CPU).
 test: $(STAMP)
 	@mkdir -p _build
 	@if [ -z "$$BOOK_REBUILD" ] && $(BIN)/python -c "import sys; sys.path.insert(0, 'tests'); \
@@ -34,7 +37,7 @@ test: $(STAMP)
 	  then echo "Reusing the current build in _build"; : > _build/book.out; \
 	  else echo "Building the book in the background (output: _build/book.out)"; \
 	       $(MAKE) --no-print-directory book > _build/book.out 2>&1 & fi; \
-	$(BIN)/python -m pytest -n 2 -m "not book and not browser"; fast=$$?; \
+	NUMBA_NUM_THREADS=1 OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 nice -n 10 $(BIN)/python -m pytest -n 2 -m "not book and not browser"; fast=$$?; \
 	wait; \
 	BOOK_REBUILD= $(BIN)/python -m pytest -m "book or browser"; slow=$$?; \
 	test $$fast = 0 && test $$slow = 0
