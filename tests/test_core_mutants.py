@@ -314,3 +314,71 @@ def test_least_squares_allocation_broadcasts_one_demand_over_many_headings():
         assert F[i] == pytest.approx(float(Fi), rel=1e-14, abs=0) and beta[i] == pytest.approx(float(bi), rel=1e-14, abs=0)  # measured 0
     with pytest.raises(TypeError, match=r"^body must be a lib\.params\.Body, got str$"):
         A.allocate_least_squares(tau, 0.0, "body")
+
+
+# ------------------------------------------------- argument validation (run of 04:28 UTC)
+
+
+def test_closed_loop_names_a_wrong_model():
+    kin = reference_of(T.eight())
+    with pytest.raises(TypeError, match=r"^model must be a lib\.params\.Body or None, got str$"):
+        ClosedLoop.of(Body(), Gains(), kin, model="body")
+
+
+def test_closed_loop_uses_its_model_for_the_demand_and_the_allocation():
+    # a mismatched model: (23) and the allocation use the model, the integration the plant
+    # (the least-squares law, which depends on the body's geometry; the paper's law does not)
+    body, mdl = Body(), Body(m=3.0, I=0.2, a=0.5, c=0.7)
+    kin, law = reference_of(T.eight()), Allocation("least_squares", (1.0, 1.0, 1.0))
+    loop = ClosedLoop.of(body, Gains(), kin, law, model=mdl)
+    assert loop.model is mdl
+    z, dz = np.array([1.0, 0.2, 0.3]), np.array([0.1, -0.2, 0.5])
+    tau, F, beta = loop.inputs(2.0, z, dz)
+    tau_m = control.computed_torque_from(mdl, Gains(), *kin(2.0), z, dz)
+    np.testing.assert_allclose(tau, tau_m, rtol=1e-15, atol=0)  # measured 0: the same call
+    F_m, beta_m = law.bind(mdl)(tau_m, z[2])
+    assert F == pytest.approx(float(F_m), rel=1e-15, abs=0)  # measured 0: the same call
+    assert beta == pytest.approx(float(beta_m), rel=1e-15, abs=0)  # measured 0: the same call
+    # and the plant's own parameters would give other values
+    tau_b = control.computed_torque_from(body, Gains(), *kin(2.0), z, dz)
+    assert np.abs(tau_b - tau_m).max() > 1e-2  # reason: a property, the two bodies differ (m 2 vs 3), not an error bound
+    F_b, beta_b = law.bind(body)(tau_m, z[2])
+    assert abs(float(F_b) - float(F_m)) + abs(float(beta_b) - float(beta_m)) > 1e-3  # reason: a property, the two geometries differ, not an error bound
+
+
+def test_trajectory_errors_give_the_unit_of_the_value():
+    with pytest.raises(ValueError, match=r"^trajectory radius R must be positive, got -1\.0 m$"):
+        T.circle(R=-1.0, theta=1.0)
+    with pytest.raises(ValueError, match=r"^trajectory angular rate theta must be a finite number, got inf rad/s$"):
+        T.eight(R=1.0, theta=math.inf)
+
+
+def test_eight_heading_fourier_needs_2n_plus_2_samples_and_names_n_samples():
+    a = T.eight_heading_fourier(3, 8)  # the least number of samples, 2 * 3 + 2
+    assert a.shape == (4,)
+    with pytest.raises(ValueError, match=r"^n_samples must be an integer >= 8, got 7$"):
+        T.eight_heading_fourier(3, 7)
+    with pytest.raises(TypeError, match=r"^n_samples must be an integer, got float"):
+        T.eight_heading_fourier(3, 8.0)
+
+
+class _NoRef:
+    # z and dz but no ddz: named as a TypeError, not an AttributeError from the lookup
+    def z(self, t):
+        return np.zeros(3)
+
+    dz = z
+
+
+@pytest.mark.parametrize("args, exc, message", [
+    ((None, Gains()), TypeError, r"^body must be a lib\.params\.Body, got NoneType$"),
+    ((Body(), None), TypeError, r"^gains must be a lib\.params\.Gains, got NoneType$"),
+    ((Body(), Gains(), _NoRef()), TypeError, r"^ref must be a reference with z, dz and ddz methods, got _NoRef$"),
+    ((Body(), Gains(), T.eight(), [0.0, math.nan]), ValueError, r"^t\[1\] "),
+    ((Body(), Gains(), T.eight(), 0.0, np.zeros(1)), ValueError, r"^z "),
+    ((Body(), Gains(), T.eight(), 0.0, np.zeros(3), np.zeros(1)), ValueError, r"^dz "),
+])
+def test_computed_torque_names_a_wrong_argument(args, exc, message):
+    full = list(args) + [T.eight(), 0.0, np.zeros(3), np.zeros(3)][len(args) - 2:]
+    with pytest.raises(exc, match=message):
+        control.computed_torque(*full[:6])
