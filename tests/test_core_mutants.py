@@ -382,3 +382,71 @@ def test_computed_torque_names_a_wrong_argument(args, exc, message):
     full = list(args) + [T.eight(), 0.0, np.zeros(3), np.zeros(3)][len(args) - 2:]
     with pytest.raises(exc, match=message):
         control.computed_torque(*full[:6])
+
+
+# ------------------------------------------------- allocation (run of 04:42)
+
+
+@pytest.mark.parametrize("call", [
+    lambda phi, tau, w: A.allocate(tau, phi),
+    lambda phi, tau, w: A.least_squares_problem(tau, phi, Body(), w),
+    lambda phi, tau, w: A.allocate_limited(tau, phi, Body(), w),
+    lambda phi, tau, w: A.allocate_least_squares(tau, phi, Body(), w),
+])
+def test_a_non_finite_argument_of_an_allocation_is_named(call):
+    # the messages start with the argument's name (lib/checks.py): phi, tau, weights
+    good_tau, good_w = np.array([1.0, 0.5, 0.2]), (1.0, 1.0, 0.0)
+    with pytest.raises(ValueError, match=r"^phi\b"):
+        call(np.nan, good_tau, good_w)
+    with pytest.raises(ValueError, match=r"^tau\b"):
+        call(0.3, np.array([1.0, np.nan, 0.2]), good_w)
+
+
+def test_non_finite_weights_are_named():
+    with pytest.raises(ValueError, match=r"^weights\b"):
+        A.allocate_limited(np.array([1.0, 0.5, 0.2]), 0.3, Body(), (1.0, np.nan, 0.0))
+
+
+def test_singular_rows_get_the_minimum_norm_solution_and_a_non_finite_row_nan_alone():
+    # _pinv_rows on a batch: u of shape (4, 2), regular per row, A shared (3, 2), b per row;
+    # the regular rows keep u, the singular finite ones get pinv(A) b, the non-finite one NaN
+    rng = np.random.default_rng(3)
+    Am = np.array([[1.0, 2.0], [2.0, 4.0], [0.0, 0.0]])      # rank 1: singular G
+    b = rng.normal(size=(4, 3))
+    b[2, 1] = np.inf
+    u0 = np.full((4, 2), 7.0)
+    regular = np.array([True, False, False, False])
+    u = A._pinv_rows(u0, regular, Am, b)
+    assert u.shape == (4, 2)
+    assert np.array_equal(u[0], [7.0, 7.0])                 # reason: the regular row is left as given
+    want = (np.linalg.pinv(Am) @ b[[1, 3]].T).T
+    np.testing.assert_allclose(u[[1, 3]], want, rtol=1e-12, atol=1e-15)  # reason: the same pinv product, rounding only
+    assert np.all(np.isnan(u[2]))
+    assert np.array_equal(u0, np.full((4, 2), 7.0))          # reason: the input is not written to
+
+
+def test_singular_rows_broadcast_each_argument_to_the_batch():
+    # each of u, regular, A, b in turn the only one with the batch shape (2, 3)
+    Am = np.array([[1.0, 2.0], [2.0, 4.0], [0.0, 1e-300]])
+    b = np.array([1.0, -2.0, 0.5])
+    want = np.linalg.pinv(Am) @ b
+    cases = [
+        (np.zeros((2, 3, 2)), np.array(False), Am, b),
+        (np.zeros(2), np.zeros((2, 3), bool), Am, b),
+        (np.zeros(2), np.array(False), np.broadcast_to(Am, (2, 3, 3, 2)), b),
+        (np.zeros(2), np.array(False), Am, np.broadcast_to(b, (2, 3, 3))),
+    ]
+    for u0, reg, Aa, bb in cases:
+        u = A._pinv_rows(u0, reg, Aa, bb)
+        assert u.shape == (2, 3, 2)
+        np.testing.assert_allclose(u, np.broadcast_to(want, (2, 3, 2)), rtol=1e-12, atol=1e-15)  # reason: the same pinv product, rounding only
+
+
+def test_a_singular_row_with_a_non_finite_matrix_is_nan_alone():
+    # A per row (3 rows, all singular), the middle one non-finite: only that row is NaN
+    Am = np.broadcast_to(np.array([[1.0, 2.0], [2.0, 4.0], [0.0, 0.0]]), (3, 3, 2)).copy()
+    Am[1, 0, 0] = np.nan
+    b = np.array([1.0, -2.0, 0.5])
+    u = A._pinv_rows(np.zeros((3, 2)), np.zeros(3, bool), Am, b)
+    assert np.all(np.isnan(u[1]))
+    np.testing.assert_allclose(u[[0, 2]], np.broadcast_to(np.linalg.pinv(Am[0]) @ b, (2, 2)), rtol=1e-12, atol=1e-15)  # reason: the same pinv product, rounding only
