@@ -11,8 +11,8 @@ of ``lib/`` and ``tests/`` in a temporary directory (mutmut writes its mutants i
 tree), with mutmut's configuration written there as ``setup.cfg``, and writes the
 score and every surviving mutant, with its diff, to ``mutation/REPORT.md``. Each
 module is checked with the fast tests that cover it (:data:`TESTS`), not the whole
-suite. On 2 cores the six modules other than ``allocation`` take about 25 minutes and
-``allocation`` alone about 40 (its survivors run slow grid-search tests); the run is niced.
+suite. On 2 idle cores the six modules other than ``allocation`` take about 6 minutes,
+``allocation`` about 11 and the verdict procedure about 1; the run is niced.
 
 The survivors are then triaged by hand in REPORT.md: killed by a new test
 (``tests/test_core_mutants.py``) or listed as equivalent, with the reason.
