@@ -47,8 +47,6 @@ from .outcomes import STATUSES, Item, Outcome, decide
 
 __all__ = ["Outcome", "Item", "items", "table", "STATUSES"]
 
-_status = decide  # the report's short name for it
-
 
 def _erratum(key: str):
     for r in rows():
@@ -59,13 +57,13 @@ def _erratum(key: str):
 
 def _corrected_by(key: str, merit: float, merit_label: str, note: str = "") -> Outcome:
     verdict = _erratum(key).check()
-    return Outcome(_status(verdict.confirmed, "corrected"), merit, merit_label,
+    return Outcome(decide(verdict.confirmed, "corrected"), merit, merit_label,
                    note or "printed form fails, corrected form holds (see the errata row)", erratum=key)
 
 
 def _refuted_by(key: str, merit: float, merit_label: str, note: str) -> Outcome:
     verdict = _erratum(key).check()
-    return Outcome(_status(verdict.confirmed, "refuted"), merit, merit_label, note, erratum=key)
+    return Outcome(decide(verdict.confirmed, "refuted"), merit, merit_label, note, erratum=key)
 
 
 # ------------------------------------------------------------------ Sec. 2
@@ -78,7 +76,7 @@ def _open_loop_deviations() -> dict[str, float]:
 
 def _check_config_form() -> Outcome:
     dev = _open_loop_deviations()["state"]
-    return Outcome(_status(dev < 1e-7, "reproduced"), dev, f"max |q_(5) - q_(2)-(4)| over {OPEN_LOOP_HORIZON:g} s, open loop",
+    return Outcome(decide(dev < 1e-7, "reproduced"), dev, f"max |q_(5) - q_(2)-(4)| over {OPEN_LOOP_HORIZON:g} s, open loop",
                    "the body-frame form derived from (2)-(4) follows them to integration accuracy")
 
 
@@ -88,7 +86,7 @@ def _check_input_fields() -> Outcome:
     g1 = sp.Matrix([0, 0, 0, 1 / p["m"], 0, 0])
     g2 = sp.Matrix([0, 0, 0, 0, 1 / p["m"], p["a"] / p["I"]])
     n_bad = sum(sp.simplify(x) != 0 for x in list(sm.g1 - g1) + list(sm.g2 - g2))
-    return Outcome(_status(n_bad == 0, "reproduced"), float(n_bad), "entries of (9)-(10) differing from the derivation")
+    return Outcome(decide(n_bad == 0, "reproduced"), float(n_bad), "entries of (9)-(10) differing from the derivation")
 
 
 def _check_drift() -> Outcome:
@@ -107,7 +105,7 @@ def _check_eq24() -> Outcome:
     res = _circle_run()
     exact = error_dynamics_solution(Body(), Gains(), res.error[0], res.derror[0], res.t)
     dev = float(np.abs(res.error[:, :2] - exact[:, :2]).max())
-    return Outcome(_status(dev < 1e-8, "reproduced"), dev,
+    return Outcome(decide(dev < 1e-8, "reproduced"), dev,
                    "max |e_sim - e_(24)| on x, y (m), circle, 60 s",
                    "with (25)-(26) the position errors obey (24) exactly; the rotation does not")
 
@@ -117,13 +115,13 @@ def _check_allocation() -> Outcome:
     tau, phi = rng.normal(scale=5.0, size=(10000, 3)), rng.uniform(-np.pi, np.pi, 10000)
     F, beta = allocate(tau, phi)
     dev = float(np.abs(generalized_force(F, beta, phi)[:, :2] - tau[:, :2]).max())
-    return Outcome(_status(dev < 1e-12, "reproduced"), dev, "max |Q_xy - tau_xy| (N), 10^4 random demands")
+    return Outcome(decide(dev < 1e-12, "reproduced"), dev, "max |Q_xy - tau_xy| (N), 10^4 random demands")
 
 
 def _check_limits_29_30() -> Outcome:
     res = _circle_run()
     final = float(np.abs(res.error[-1, :2]).max())
-    return Outcome(_status(final < 1e-6, "reproduced"), final, "max |e_x|, |e_y| at t = 60 s (m), circle")
+    return Outcome(decide(final < 1e-6, "reproduced"), final, "max |e_x|, |e_y| at t = 60 s (m), circle")
 
 
 def _check_open_problem() -> Outcome:
@@ -146,7 +144,7 @@ def _check_open_problem() -> Outcome:
                      for b in np.linspace(-bmax, bmax, 221)], axis=0)
     gap_l = float(np.max(cost(Fl, bl) - grid_l))
     worst = max(gap, gap_l)
-    return Outcome(_status(worst <= 1e-12 and feasible, "extended"), worst,
+    return Outcome(decide(worst <= 1e-12 and feasible, "extended"), worst,
                    "max (exact cost - grid-search cost), 200 random demands, without limits and with F <= 2.5 N, "
                    "|beta| <= 2.2 rad (<= 0: never worse)",
                    "closed-form weighted least-squares allocation, and its exact solution under the limits "
@@ -159,7 +157,7 @@ def _corrected_group(prefix: str, merit_label: str) -> Outcome:
     group = [r for r in rows() if r.key.startswith(prefix)]
     verdicts = [r.check() for r in group]
     ok = bool(group) and all(v.confirmed for v in verdicts)
-    return Outcome(_status(ok, "corrected"), float(len(group)), merit_label,
+    return Outcome(decide(ok, "corrected"), float(len(group)), merit_label,
                    f"{len(group)} errata rows starting with {prefix!r}", erratum=group[0].key if group else None)
 
 
@@ -186,7 +184,7 @@ def _check_thm6() -> Outcome:
 
 def _check_thm7() -> Outcome:
     drift = float(np.linalg.norm(f(Body(), np.array([0.0, 0.0, 0.3, 1.0, 0.5, 0.2]))))
-    return Outcome(_status(drift == 0.0, "reproduced"), drift,
+    return Outcome(decide(drift == 0.0, "reproduced"), drift,
                    "|f(q)| at a moving state: the drift is not zero",
                    "Theorem 7 is for systems without drift; the conclusion of Sec. 3 cites it for this system "
                    "with drift, so it cannot be used as the paper does")
@@ -213,14 +211,14 @@ def _check_eq27_28() -> Outcome:
         z, dz = ref.z(t), ref.dz(t)
         tangent = np.arctan2(dz[:, 1], dz[:, 0])
         dev = max(dev, float(np.abs(np.angle(np.exp(1j * (z[:, 2] - tangent)))).max()))
-    return Outcome(_status(dev < 1e-12, "reproduced"), dev, "max |phi_d - tangent angle| (rad), both paths",
+    return Outcome(decide(dev < 1e-12, "reproduced"), dev, "max |phi_d - tangent angle| (rad), both paths",
                    "the eight's heading is used on its continuous branch (the printed Arg jumps by 2 pi)")
 
 
 def _check_eq31() -> Outcome:
     p_end = float(_circle_run().rotation_error()[-1])
     dev = abs(p_end - circle_equilibria(Body(), 2.0, np.pi / 4)[0])
-    return Outcome(_status(dev < 1e-6, "reproduced"), dev,
+    return Outcome(decide(dev < 1e-6, "reproduced"), dev,
                    "|p(60 s) - p0| (rad), circle, p0 from the corrected (33)")
 
 
@@ -228,7 +226,7 @@ def _check_fig2() -> Outcome:
     res = _circle_run()
     p = res.rotation_error()
     late = res.t >= 50.0
-    return Outcome(_status(float(np.ptp(p[late])) < 1e-6, "reproduced"), float(p[-1]),
+    return Outcome(decide(float(np.ptp(p[late])) < 1e-6, "reproduced"), float(p[-1]),
                    "steady rotation error (rad) on the circle, Table parameters",
                    "positions converge, the rotation error settles to a constant")
 
@@ -240,7 +238,7 @@ def _check_fig3() -> Outcome:
     orb = rotation_attractor(Body(), "eight", 2.0, np.pi / 4)
     rng_circle = steady_summary(_circle_run(), 2.0)["p_range"]  # t >= 44 s
     ok = orb.period == 1 and orb.range > 1.0 and orb.range > 1e3 * max(rng_circle, 1e-12)
-    return Outcome(_status(ok, "reproduced"), orb.range,
+    return Outcome(decide(ok, "reproduced"), orb.range,
                    "range of p (rad) on the eight's attracting period-1 orbit (R = 2 m, theta = pi/4 chosen: "
                    "not stated in the paper)",
                    "the rotation problem is much more visible on the eight than on the circle")
@@ -260,7 +258,7 @@ def _check_fig4() -> Outcome:
     last, prev = e[-200:], e[-400:-200]
     amplitude, drift = float(last.max()), float(np.abs(last - prev).max())
     ok = amplitude > 1e-2 and drift < 1e-4 * max(1.0, amplitude)
-    return Outcome(_status(ok, "reproduced"), amplitude,
+    return Outcome(decide(ok, "reproduced"), amplitude,
                    "steady max position error (m) with F <= 4 N on the eight; periodic to 1e-4",
                    "a non-zero periodic position error, as the paper says")
 
@@ -281,7 +279,7 @@ def _check_chaos() -> Outcome:
     chaos = free[free.angle_deg.round() == 30].iloc[0]
     cha = free[free.regime == "chaotic"]
     ok = chaos.regime == "chaotic" and chaos.lyapunov > 6 * chaos.lyapunov_stderr and len(cha) > 0
-    return Outcome(_status(ok, "reproduced"), chaos.lyapunov,
+    return Outcome(decide(ok, "reproduced"), chaos.lyapunov,
                    "largest Lyapunov exponent (1/s), angle limit 30 deg, no force cap, eight",
                    f"chaotic at {len(cha)} of {len(free)} angle limits from {SWEEP_DEG[0]} to {SWEEP_DEG[-1]} deg "
                    "without a cap (Chapter 4)")
@@ -297,7 +295,7 @@ def _check_quasi() -> Outcome:
     qp = extend_undecided(body, gains, ref, limit_verdicts(body, gains, ref, np.radians([37.0]), 6.0)[0]).iloc[0]
     with_cap = (qp.regime == "quasiperiodic" and abs(qp.lyapunov) * ref.period < 0.0075
                 and 3 * qp.lyapunov_stderr * ref.period < 0.0075 and qp.floquet > 1.1)
-    return Outcome(_status(n_alone > 0, "reproduced"), float(n_alone),
+    return Outcome(decide(n_alone > 0, "reproduced"), float(n_alone),
                    f"angle limits ({SWEEP_DEG[0]}-{SWEEP_DEG[-1]} deg, no cap) with quasi-periodic errors",
                    "not with the angle limit alone on this eight; "
                    + ("it occurs when a force cap is added (37 deg with 6 N, Chapter 4)" if with_cap else
@@ -311,7 +309,7 @@ def _check_eq32() -> Outcome:
     # autonomous in p on the circle, as (33) presumes, and with the paper's drag terms
     k = eq.params
     drag = sp.simplify(eq.rhs.diff(eq.v_p) + k["c_phi"] / k["I"])
-    return Outcome(_status(drag == 0, "reproduced"), 0.0 if drag == 0 else 1.0,
+    return Outcome(decide(drag == 0, "reproduced"), 0.0 if drag == 0 else 1.0,
                    "symbolic residual of the damping term -c_phi/I v_p",
                    "(32) derived from (4) with (25)-(26); on the circle it is autonomous in p")
 
@@ -331,7 +329,7 @@ def _check_eq34_35() -> Outcome:
         J = circle_jacobian(b, R, th, circle_equilibria(b, R, th)[0])  # the linearisation (34)
         lam35 = circle_eigenvalues(b, R, th)                            # the roots of (35)
         dev = max(dev, float(np.abs(np.sort_complex(np.linalg.eigvals(J)) - np.sort_complex(lam35)).max()))
-    return Outcome(_status(dev < 1e-9, "reproduced"), dev,
+    return Outcome(decide(dev < 1e-9, "reproduced"), dev,
                    "max |eigenvalue of (34) - root of (35)| (1/s), three (R, theta)")
 
 
@@ -350,7 +348,7 @@ def _check_eq36() -> Outcome:
     b, th = Body(), np.pi / 4
     Rc = brentq(lambda R: _rest_margin(b, R, th), 1e-3, 10.0, xtol=1e-15)
     dev = abs(circle_critical_radius(b, th) - Rc) / Rc
-    return Outcome(_status(dev < 1e-9, "reproduced"), dev,
+    return Outcome(decide(dev < 1e-9, "reproduced"), dev,
                    "relative difference of the boundary where (33) loses its equilibria from (36), theta = pi/4")
 
 
@@ -358,7 +356,7 @@ def _check_gas() -> Outcome:
     b, th = Body(), 1.5
     ratio = 1.1
     coexists = bool(np.asarray(circle_slipping_coexists(b, ratio * circle_critical_radius(b, th), th)))
-    return Outcome(_status(not coexists, "reproduced"), ratio,
+    return Outcome(decide(not coexists, "reproduced"), ratio,
                    "R / R_crit at theta = 1.5 rad/s where a slipping motion coexists with the equilibrium",
                    "not global: the saddle's stable manifold never reaches p0, and near R_crit at higher rates "
                    "a motion that slips for ever coexists with the stable equilibrium")
@@ -380,7 +378,7 @@ def _check_fig5() -> Outcome:
     m = map_summary(frame)
     lost = m.n_lost / m.n_grid
     n = FIG5_GRID["n"]
-    return Outcome(_status(0.0 < lost < 1.0 and m.n_undecided <= 0.05 * m.n_grid, "extended"), lost,
+    return Outcome(decide(0.0 < lost < 1.0 and m.n_undecided <= 0.05 * m.n_grid, "extended"), lost,
                    f"fraction of Chapter 5's {n} x {n} map where the heading is lost (it slips); at most 5 % undecided",
                    f"each point decided (periodic orbits with Floquet multipliers, Lyapunov exponents, drift); "
                    f"the heading turns round (the other reading) at a fraction {m.n_turns_round / m.n_grid:.3f}; "
