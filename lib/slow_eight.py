@@ -57,7 +57,7 @@ import numpy as np
 
 from . import checks
 from .params import Body
-from .rotation_field import coefficients
+from .rotation_field import coefficients, rotation_rates, rotation_rates_dphi
 from .trajectories import PAPER_HEADING_SERIES, eight_position
 
 __all__ = ["SlowEight", "slow_eight_prediction", "unit_eight_geometry", "frozen_heading", "follow_radius",
@@ -232,13 +232,13 @@ def _forcing(n: int):
 def _rate(phi, j, A, B, C, f, corrected: bool):
     """phi_s of the overdamped heading (T / A) or with the first inertia correction."""
     X1, Y1, X2, Y2, X3, Y3 = (a[j] for a in f)
-    P, Q = B * Y1 + C * Y2, B * X1 + C * X2
-    cp, sp = np.cos(phi), np.sin(phi)
-    T = P * cp - Q * sp
+    # the torque of (32) at rest (w = 0) from its one definition, its derivative along the
+    # path (the same field with the derivatives one order up) and its derivative in phi
+    T = rotation_rates(phi, 0.0, A, B, C, X1, Y1, X2, Y2)[1]
     if not corrected:
         return T / A
-    Ts = (B * Y2 + C * Y3) * cp - (B * X2 + C * X3) * sp
-    Tphi = -P * sp - Q * cp
+    Ts = rotation_rates(phi, 0.0, A, B, C, X2, Y2, X3, Y3)[1]
+    Tphi = rotation_rates_dphi(phi, B, C, X1, Y1, X2, Y2)
     return T / A - (Ts + Tphi * T / A) / A**2
 
 
