@@ -714,3 +714,37 @@ def test_a_two_cycle_a_whole_turn_apart_is_of_period_two_in_a_plain_coordinate()
     out = _find(pm, runs, turns=False)
     assert out["status"].tolist() == ["found"]
     assert (out["k"][0], out["n"][0], out["lag"][0]) == (2, 0, 2)
+
+
+# ---------------------------------------------------------------- the two survivors of the 04:20 run (issue 22)
+
+
+def test_find_orbits_tells_a_two_cycle_from_a_fixed_point_at_100_newton_tol():
+    # a 2-cycle x = +-q (ToyMap mode 2) whose points lie 2 q apart: P(x) - x = -2 q. find_orbits
+    # takes the least period as the smallest d with P^d(x) = x within 100 newton_tol (its
+    # docstring): 2 q = 100.5 newton_tol is period 2, 2 q = 99.5 newton_tol period 1 (closer than
+    # Newton's accuracy allows to tell). Newton converges on both (residual <= newton_tol = 1e-12)
+    tol = OPTS["newton_tol"]
+    ks = []
+    for gap in (100.5, 99.5):
+        q = 0.5 * gap * tol
+        pm = ToyMap(a=0.6, b=0.5, mode=2, phi0=-0.4, q=q)
+        out = _find(pm, pm.run([[q, -0.4]], 13))
+        assert out["found"][0] and out["lag"][0] == 2, out["status"]
+        ks.append(int(out["k"][0]))
+    assert ks == [2, 1]
+
+
+def test_section_returns_judge_the_state_at_a_third_of_the_run_too():
+    # a circle filled by an irrational rotation, but the state at L // 3 is off it (radius 1.6)
+    # and never come back to: seen from the first state the run returns as on a closed curve,
+    # seen from the state at L // 3 it never comes within about 0.6 / 2.6 of it. The documented
+    # references are the states at 0 and L // 3, and the worse one counts.
+    L = 120
+    k = np.arange(L)[:, None]
+    rot = 2 * np.pi * (np.sqrt(5) - 1) / 2
+    sec = np.stack([np.cos(k * rot), np.sin(k * rot)], axis=2)
+    sec[L // 3] *= 1.6
+    r = dv.section_returns(sec, angles=())
+    assert r[0] > 0.2            # measured 0.223: about (1.6 - 1) / 2.6, the outlier's gap over D
+    assert dv.section_returns(np.delete(sec, L // 3, axis=0), angles=())[0] < 0.05  # measured 0.021 without it

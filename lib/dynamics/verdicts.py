@@ -143,7 +143,10 @@ def find_orbits(step: Callable, pmap: PeriodMap, idx, hist, *, max_period: int, 
     counts when Newton converges to ``newton_tol``, every Floquet multiplier lies inside
     the unit circle and the run has :func:`reached` it (``reach_tol``, ``reach_floor``;
     the earlier distance taken k floor(M / k) periods back, M = min(L - 1, 2
-    ``max_period``)). Where an attracting orbit of period k is found but not yet
+    ``max_period``)). Its least period is the smallest divisor d of k whose P^d returns
+    the orbit point to within 100 ``newton_tol`` (:func:`least_period`: Newton's point is
+    accurate to ``newton_tol``, its images to a few times that, and a shorter orbit closer
+    than this is not told apart). Where an attracting orbit of period k is found but not yet
     reached, its multiples are not tried (they would find it again). ``tried``
     (max_period, N), updated in place when given: the lag-k defect at which Newton last
     ran; lag k is tried again only once the defect has halved.
