@@ -331,8 +331,8 @@ def closed_loop_verdicts(body: Body, gains: Gains, kind: str, R, Theta, weights=
         multiplier modulus), lyapunov, lyapunov_stderr (1/s; for an orbit ln|mu_1| / (k T)),
         slip, slip_stderr (turns per period), lost, pos_drift, pos_drift_stderr (m per period),
         position_lost, tracked, residual, distance, turns_round, p_range (rad, over the last block),
-        p_rms (rad, RMS of p wrapped to (-pi, pi], last block), pos_rms, pos_max (m, last block),
-        periods, reason.
+        p_rms (rad, RMS of p wrapped to (-pi, pi], last block), pos_rms, pos_max (m, last block;
+        NaN where the run diverged), periods, reason.
     """
     kinds = np.atleast_1d(np.asarray(kind, dtype=object))
     if kinds.ndim != 1 or kinds.size == 0:
@@ -370,9 +370,11 @@ def _verdict_chunk(kinds, R, Theta, w, z0, dz0, *, body, gains, allocation, limi
     out = _decide(flow, obs, w[:, 2] == 0, o)
     acc = obs["acc"]
     cnt = acc["cnt"][-1]
-    return pd.DataFrame({"kind": kinds, "R": R, "Theta": Theta, "w_phi": w[:, 2], **out,
-                         "p_range": acc["lmax"] - acc["lmin"], "p_rms": np.sqrt(acc["p2"] / cnt),
-                         "pos_rms": np.sqrt(acc["pos2"] / cnt), "pos_max": acc["posmax"],
+    # a run that diverged has no steady measures: NaN, not what the NaN-skipping sums left
+    steady = {"p_range": acc["lmax"] - acc["lmin"], "p_rms": np.sqrt(acc["p2"] / cnt),
+              "pos_rms": np.sqrt(acc["pos2"] / cnt), "pos_max": acc["posmax"]}
+    steady = {k: np.where(obs["finite"], v, np.nan) for k, v in steady.items()}
+    return pd.DataFrame({"kind": kinds, "R": R, "Theta": Theta, "w_phi": w[:, 2], **out, **steady,
                          "periods": int(obs["t_end"]), "steps": o["steps"]})
 
 
