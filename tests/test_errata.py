@@ -9,7 +9,7 @@ ROWS = errata.rows()
 
 @pytest.mark.parametrize("row", ROWS, ids=[r.key for r in ROWS])
 def test_erratum_printed_form_fails_and_corrected_form_holds(row):
-    verdict = row.check()
+    verdict = errata.verdict(row.key)   # the check, run once per library state when the book is built beside
     assert not verdict.printed_holds, f"{row.key}: the printed form passed its check ({verdict.detail})"
     assert verdict.corrected_holds, f"{row.key}: the corrected form failed its check ({verdict.detail})"
 

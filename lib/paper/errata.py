@@ -18,10 +18,11 @@ from __future__ import annotations
 
 import pandas as pd
 
+from ..book_cache import cached
 from . import model_errata, reading_errata, rotation_errata, tracking_errata
 from .verdicts import Erratum, Verdict
 
-__all__ = ["Erratum", "Verdict", "rows", "table", "SOURCES"]
+__all__ = ["Erratum", "Verdict", "rows", "verdict", "table", "SOURCES"]
 
 #: the modules that contribute rows, in the order of the paper's sections
 SOURCES = (model_errata, tracking_errata, rotation_errata, reading_errata)
@@ -39,6 +40,20 @@ def rows() -> list[Erratum]:
     return out
 
 
+def verdict(key: str) -> Verdict:
+    """The verdict of the row ``key``'s check. In a book build it is computed once per state
+    of the library (:func:`lib.book_cache.cached`) and shared by the errata page, the
+    report, Chapter 5 and the tests run beside the build; elsewhere it is simply computed."""
+    return cached(_check_row, key)
+
+
+def _check_row(key: str) -> Verdict:
+    for r in rows():
+        if r.key == key:
+            return r.check()
+    raise KeyError(f"no errata row {key!r}")
+
+
 def table(run_checks: bool = True):
     """The errata as a pandas DataFrame; with ``run_checks`` each row's verdict is computed."""
     records = []
@@ -46,7 +61,7 @@ def table(run_checks: bool = True):
         rec = {"key": r.key, "where": r.where, "printed": r.printed, "corrected": r.corrected,
                "verified by": r.verified_by, "section": r.section}
         if run_checks:
-            v = r.check()
+            v = verdict(r.key)
             rec["confirmed"] = v.confirmed
             rec["detail"] = v.detail
         records.append(rec)

@@ -41,11 +41,11 @@ from ..symbolic import derive_body_frame, rank_determinants
 from ..tracking import steady_summary
 from ..trajectories import circle, eight, eight_heading_fourier
 from ..book_cache import cached
-from .errata import rows
+from .errata import rows, verdict
 from .extensions import items as extension_items
 from .outcomes import STATUSES, Item, Outcome, decide
 
-__all__ = ["Outcome", "Item", "items", "table", "STATUSES"]
+__all__ = ["Outcome", "Item", "items", "outcome", "table", "STATUSES"]
 
 
 def _erratum(key: str):
@@ -56,14 +56,14 @@ def _erratum(key: str):
 
 
 def _corrected_by(key: str, merit: float, merit_label: str, note: str = "") -> Outcome:
-    verdict = _erratum(key).check()
-    return Outcome(decide(verdict.confirmed, "corrected"), merit, merit_label,
+    v = verdict(_erratum(key).key)
+    return Outcome(decide(v.confirmed, "corrected"), merit, merit_label,
                    note or "printed form fails, corrected form holds (see the errata row)", erratum=key)
 
 
 def _refuted_by(key: str, merit: float, merit_label: str, note: str) -> Outcome:
-    verdict = _erratum(key).check()
-    return Outcome(decide(verdict.confirmed, "refuted"), merit, merit_label, note, erratum=key)
+    v = verdict(_erratum(key).key)
+    return Outcome(decide(v.confirmed, "refuted"), merit, merit_label, note, erratum=key)
 
 
 # ------------------------------------------------------------------ Sec. 2
@@ -155,7 +155,7 @@ def _check_open_problem() -> Outcome:
 
 def _corrected_group(prefix: str, merit_label: str) -> Outcome:
     group = [r for r in rows() if r.key.startswith(prefix)]
-    verdicts = [r.check() for r in group]
+    verdicts = [verdict(r.key) for r in group]
     ok = bool(group) and all(v.confirmed for v in verdicts)
     return Outcome(decide(ok, "corrected"), float(len(group)), merit_label,
                    f"{len(group)} errata rows starting with {prefix!r}", erratum=group[0].key if group else None)
@@ -439,11 +439,25 @@ def items() -> list[Item]:
     ] + extension_items()
 
 
+def outcome(key: str) -> Outcome:
+    """The outcome of the row ``key``'s check. In a book build it is computed once per state
+    of the library (:func:`lib.book_cache.cached`) and shared by the report page and the
+    tests run beside the build; elsewhere it is simply computed."""
+    return cached(_check_item, key)
+
+
+def _check_item(key: str) -> Outcome:
+    for it in items():
+        if it.key == key:
+            return it.check()
+    raise KeyError(f"no report row {key!r}")
+
+
 def table():
     """Run every check; the report as a pandas DataFrame."""
     records = []
     for it in items():
-        out = it.check()
+        out = outcome(it.key)
         records.append({"key": it.key, "paper": it.paper, "section": it.section, "expected": it.expected,
                         "status": out.status, "merit": out.merit, "merit_label": out.merit_label,
                         "note": out.note, "erratum": out.erratum})
