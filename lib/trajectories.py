@@ -41,6 +41,11 @@ class Reference:
     def ddz(self, t) -> np.ndarray:  # pragma: no cover - interface
         raise NotImplementedError
 
+    def kinematics(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(z_d, dz_d, ddz_d) at t (s), each (..., 3): what a closed loop reads at every step.
+        A path computes the three at once (:class:`_Path`); this default asks for each."""
+        return self.z(t), self.dz(t), self.ddz(t)
+
 
 @dataclass(frozen=True)
 class _Path(Reference):
@@ -62,6 +67,10 @@ class _Path(Reference):
 
     def _kin(self, t):
         return KINEMATICS[self._kind](self.R, self.theta, t)
+
+    def kinematics(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(z_d, dz_d, ddz_d) at t (s), from one evaluation of the path's kinematics."""
+        return self._kin(t)
 
     def z(self, t) -> np.ndarray:
         return self._kin(t)[0]
