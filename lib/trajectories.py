@@ -43,7 +43,7 @@ class Reference:
 
     def kinematics(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(z_d, dz_d, ddz_d) at t (s), each (..., 3): what a closed loop reads at every step.
-        A path computes the three at once (:class:`_Path`); this default asks for each."""
+        :class:`Circle` and :class:`Eight` compute the three at once; this default asks for each."""
         return self.z(t), self.dz(t), self.ddz(t)
 
 
