@@ -4,7 +4,7 @@ the "Library reference" page. reST would take ``|beta|`` for a substitution refe
 every ``|`` outside inline literals and roles is escaped before autodoc renders the
 docstring (after napoleon has turned its numpydoc sections into fields).
 
-A name a module re-exports (``lib.weighting.closed_loop_verdicts``) is documented once,
+A name a module re-exports (``lib.weighting.verdicts.closed_loop_verdicts``) is documented once,
 where it is defined; a cross-reference to it by the name in use resolves there."""
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ def setup(app):
 def _canonical(modname: str | None, target: str) -> str | None:
     """Where the object a docstring names (``target``, seen from module ``modname``) is
     defined: a re-exported function or class, named where it is used, is documented where
-    it is defined (``lib.limits.switched_runs`` is :func:`lib.switched_runs.switched_runs`)."""
+    it is defined (``lib.limits.switched_runs`` is :func:`lib.limits.runs.switched_runs`)."""
     import importlib
 
     parts = target.split(".")

@@ -2,7 +2,7 @@
 
 Run with ``make benchmark`` (or ``.venv/bin/python benchmarks/bench_eight_sweep.py``).
 
-Fast: :func:`lib.stability.eight_rotation_sweep` (:func:`lib.rotation_verdicts.rotation_verdicts`:
+Fast: :func:`lib.stability.eight_rotation_sweep` (:func:`lib.rotation.verdicts.rotation_verdicts`:
 Newton on the compiled period map, Lyapunov exponents for the rest) on the 100 x 100
 grid R in [0.25, 4] m, Theta in [0.05, 1.5] rad/s, timed after one warm-up call that
 compiles the kernels (cached on disk); its time per grid point is total / 10000.

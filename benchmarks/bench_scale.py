@@ -5,12 +5,12 @@ Run with ``make benchmark`` (or ``.venv/bin/python benchmarks/bench_scale.py``).
 Every process here runs numba on one thread (``NUMBA_NUM_THREADS=1``, set before numba
 is imported, and inherited by the spawned workers), so that "one worker" is one core.
 
-1. The cost per point as the map grows: :func:`lib.rotation_verdicts.fig5_map` on the
+1. The cost per point as the map grows: :func:`lib.rotation.verdicts.fig5_map` on the
    n x n grid for n in ``--sizes`` (100, 200, 300), in this process, after a warm-up
    call that loads the compiled kernels. The cost is linear in the points when the time
    per point stays flat.
 2. One against two workers: the ``--workers-n`` x ``--workers-n`` map (100) through
-   :func:`lib.parallel.process_pool` (spawned processes; ``--dask`` uses a
+   :func:`lib.machinery.parallel.process_pool` (spawned processes; ``--dask`` uses a
    ``distributed.LocalCluster`` instead), each pool warmed by a small map first so that
    its start-up is not timed; both frames are checked equal to the single-process one.
 
@@ -31,8 +31,8 @@ from contextlib import contextmanager  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from lib.params import Body  # noqa: E402
-from lib.parallel import process_pool  # noqa: E402
-from lib.rotation_verdicts import fig5_map  # noqa: E402
+from lib.machinery.parallel import process_pool  # noqa: E402
+from lib.rotation.verdicts import fig5_map  # noqa: E402
 
 
 @contextmanager

@@ -4,7 +4,7 @@ Run with ``make benchmark`` (or ``.venv/bin/python benchmarks/bench_switched.py`
 
 Today's path (before issue 12): :class:`lib.integrators.switched.SwitchedLoop`,
 scipy's adaptive DOP853 with event location, one run at a time, at the tolerance
-Chapter 4 used (rtol = atol = 1e-9). New path: :func:`lib.limits.switched_runs`
+Chapter 4 used (rtol = atol = 1e-9). New path: :func:`lib.limits.runs.switched_runs`
 (:mod:`lib.integrators.switched_compiled`, numba, 200 fixed DOP853 steps per period,
 every event located by redoing the step), all runs in one parallel call, timed after
 a warm-up call that compiles the kernels (cached on disk).
@@ -17,9 +17,9 @@ Workload: the eight of Chapter 4 from the paper's start at angle limits 20, 30, 
    the book's 200 steps per period and with 400 (target <= 1e-6 with 400; at 200 the
    violent start at 20 degrees costs more, which the verdicts do not feel: Chapter 4
    re-decides its table with 400 steps);
-3. decisions: Chapter 4's earlier verdicts (:func:`lib.limits.sweep_angle_limit`, 15 + 16
+3. decisions: Chapter 4's earlier verdicts (:func:`lib.limits.sections.sweep_angle_limit`, 15 + 16
    periods of section and 48 of Lyapunov renormalisation at rtol 1e-9, one angle at a
-   time on 2 processes) against :func:`lib.limits.limit_verdicts` (60 + 120 periods,
+   time on 2 processes) against :func:`lib.limits.verdicts.limit_verdicts` (60 + 120 periods,
    Newton and Floquet multipliers) at 20, 40, 60 and 90 degrees: time per decided limit;
 4. the whole of Chapter 4's two 81-angle sweeps, decided (target <= 60 s on 2 cores).
 """
@@ -31,7 +31,8 @@ import time
 
 import numpy as np
 
-from lib import limits, trajectories
+from lib.limits import verdicts as limits
+from lib import trajectories
 from lib.params import PAPER_DZ0, PAPER_Z0, Body, Gains
 
 DEG = [20, 30, 45, 60, 90]

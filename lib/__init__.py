@@ -15,14 +15,14 @@ Where to start (import the modules you need; ``import lib`` itself loads nothing
 * ``lib.tracking``: the runs and numbers of Figs. 2-4 (``run``, ``steady_summary``,
   ``force_cap_sweep``);
 * ``lib.stability.eight_rotation_sweep``: the verdicts of Fig. 5 over (R, Theta) grids;
-* ``lib.limits.limit_verdicts``: the regime under an angle limit and a force cap;
-* ``lib.weighting.closed_loop_verdicts``: the verdicts on the full closed loop, for any
+* ``lib.limits.verdicts.limit_verdicts``: the regime under an angle limit and a force cap;
+* ``lib.weighting.verdicts.closed_loop_verdicts``: the verdicts on the full closed loop, for any
   allocation weights (Chapter 6).
 
 Every sweep takes ``executor=`` (any ``concurrent.futures.Executor``, a dask cluster's
-included; ``lib.parallel.map_chunks``) and ``progress=`` (a progress bar, shown by default
-only when run interactively: ``lib.parallel.show_progress``). Every public function checks
-its arguments with ``lib.checks``: a wrong type is a ``TypeError``, a wrong value a
+included; ``lib.machinery.parallel.map_chunks``) and ``progress=`` (a progress bar, shown by default
+only when run interactively: ``lib.machinery.parallel.show_progress``). Every public function checks
+its arguments with ``lib.machinery.checks``: a wrong type is a ``TypeError``, a wrong value a
 ``ValueError``, each naming the argument (and the index in an array).
 
 README.md's "Where to start in the library" runs a small Fig. 5 map and a capped circle;

@@ -20,7 +20,7 @@ from typing import Callable
 
 import numpy as np
 
-from . import checks
+from .machinery import checks
 from .angles import wrap_angle
 from .model import input_matrix
 from .params import Body
@@ -35,9 +35,9 @@ def _check_limit(name: str, value, upper: float | None) -> float:
 
 @dataclass(frozen=True)
 class Limits:
-    """Force and angle limits of the paper's Sec. 5: F <= ``force`` (N, eq. (29)) and
-    |beta| <= ``angle`` (rad, in (0, pi], eq. (30)); None means no limit. Validated
-    on construction.
+    """Force and angle limits of the paper's Sec. 5 (Fig. 4; the paper gives them no equation
+    number): F <= ``force`` (N) and |beta| <= ``angle`` (rad, in (0, pi]); None means no
+    limit. Validated on construction.
 
     Parameters
     ----------
@@ -50,7 +50,7 @@ class Limits:
     ------
     TypeError
         If a limit is not a real number (a str, a bool, an array), naming it
-        (``force_limit``, ``angle_limit``).
+        (``force``, ``angle``).
     ValueError
         If a limit is not positive and finite, or the angle exceeds pi.
     """
@@ -60,9 +60,9 @@ class Limits:
 
     def __post_init__(self) -> None:
         if self.force is not None:
-            object.__setattr__(self, "force", _check_limit("force_limit", self.force, upper=None))
+            object.__setattr__(self, "force", _check_limit("force", self.force, upper=None))
         if self.angle is not None:
-            object.__setattr__(self, "angle", _check_limit("angle_limit", self.angle, upper=np.pi))
+            object.__setattr__(self, "angle", _check_limit("angle", self.angle, upper=np.pi))
 
     def apply(self, F, beta):
         """Cap F at ``force`` (the direction kept) and clip beta to [-angle, angle]:
@@ -72,6 +72,15 @@ class Limits:
         if self.angle is not None:
             beta = np.clip(beta, -self.angle, self.angle)
         return F, beta
+
+
+def _limits_named(force_limit, angle_limit) -> Limits:
+    """``Limits`` from a function's ``force_limit`` and ``angle_limit``, an error naming them so."""
+    if force_limit is not None:
+        force_limit = _check_limit("force_limit", force_limit, upper=None)
+    if angle_limit is not None:
+        angle_limit = _check_limit("angle_limit", angle_limit, upper=np.pi)
+    return Limits(force_limit, angle_limit)
 
 
 def allocate(tau, phi, force_limit: float | None = None, angle_limit: float | None = None):
@@ -101,9 +110,9 @@ def allocate(tau, phi, force_limit: float | None = None, angle_limit: float | No
     phi : array_like
         Heading (rad), broadcast against ``tau[..., 0]``.
     force_limit : float, optional
-        F_max (N), > 0: F is capped at it (eq. (29)); None for no cap.
+        F_max (N), > 0: F is capped at it; None for no cap.
     angle_limit : float, optional
-        beta_max (rad), in (0, pi]: beta is clipped to [-beta_max, beta_max] (eq. (30));
+        beta_max (rad), in (0, pi]: beta is clipped to [-beta_max, beta_max];
         None for no limit.
 
     Returns
@@ -120,7 +129,7 @@ def allocate(tau, phi, force_limit: float | None = None, angle_limit: float | No
     ValueError
         If an argument is out of range or not finite (an array's first bad index named).
     """
-    return _position(_check_tau(tau, (2, 3)), checks.array("phi", phi), Limits(force_limit, angle_limit))
+    return _position(_check_tau(tau, (2, 3)), checks.array("phi", phi), _limits_named(force_limit, angle_limit))
 
 
 def _position(tau, phi, limits: Limits):
@@ -273,9 +282,9 @@ def allocate_limited(tau, phi, body: Body, weights=(1.0, 1.0, 0.0),
     weights : array_like
         (w_x, w_y, w_phi) >= 0, not all zero, shape (3,) or (..., 3).
     force_limit : float, optional
-        F_max (N), > 0: F is capped at it (eq. (29)); None for no cap.
+        F_max (N), > 0: F is capped at it; None for no cap.
     angle_limit : float, optional
-        beta_max (rad), in (0, pi]: beta is clipped to [-beta_max, beta_max] (eq. (30));
+        beta_max (rad), in (0, pi]: beta is clipped to [-beta_max, beta_max];
         None for no limit.
 
     Returns
@@ -292,7 +301,7 @@ def allocate_limited(tau, phi, body: Body, weights=(1.0, 1.0, 0.0),
     ValueError
         If an argument is out of range or not finite (an array's first bad index named).
     """
-    limits = Limits(force_limit, angle_limit)
+    limits = _limits_named(force_limit, angle_limit)
     return _limited(_check_tau(tau), checks.array("phi", phi), _checked_body(body), np.sqrt(_check_weights(weights)), limits)
 
 
@@ -401,9 +410,9 @@ def allocate_least_squares(tau, phi, body: Body, weights=(1.0, 1.0, 0.0),
     weights : array_like
         (w_x, w_y, w_phi) >= 0, not all zero, shape (3,) or (..., 3).
     force_limit : float, optional
-        F_max (N), > 0: F is capped at it (eq. (29)); None for no cap.
+        F_max (N), > 0: F is capped at it; None for no cap.
     angle_limit : float, optional
-        beta_max (rad), in (0, pi]: beta is clipped to [-beta_max, beta_max] (eq. (30));
+        beta_max (rad), in (0, pi]: beta is clipped to [-beta_max, beta_max];
         None for no limit.
 
     Returns
@@ -420,7 +429,7 @@ def allocate_least_squares(tau, phi, body: Body, weights=(1.0, 1.0, 0.0),
     ValueError
         If an argument is out of range or not finite (an array's first bad index named).
     """
-    limits = Limits(force_limit, angle_limit)
+    limits = _limits_named(force_limit, angle_limit)
     return _weighted(_check_tau(tau), checks.array("phi", phi), _checked_body(body), np.sqrt(_check_weights(weights)), limits)
 
 

@@ -3,7 +3,7 @@ allocation (:mod:`lib.allocation`), as one vector field vectorised over points.
 
 This is the single closed-loop right-hand side behind the smooth integrator
 (:func:`lib.simulate.simulate`) and the batch integrator
-(:func:`lib.weighting.closed_loop_batch`); the switched integrator
+(:func:`lib.weighting.batch.closed_loop_batch`); the switched integrator
 (:mod:`lib.integrators.switched`) uses a scalar fast path of the same equations,
 tested against this one at random states.
 """
@@ -15,7 +15,7 @@ from typing import Callable
 
 import numpy as np
 
-from . import checks
+from .machinery import checks
 from .allocation import Allocation, Allocator, Limits
 from .control import computed_torque_from
 from .model import config_accel

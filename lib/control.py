@@ -12,13 +12,13 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg import expm
 
-from . import checks
+from .machinery import checks
 from .allocation import allocate, allocate_least_squares, allocate_limited, residual
 from .angles import wrap_angle
 from .model import input_matrix
 from .params import Body, Gains
 
-__all__ = ["computed_torque", "computed_torque_from", "computed_torque_rate", "error_dynamics_solution",
+__all__ = ["computed_torque", "computed_torque_from", "demand", "computed_torque_rate", "error_dynamics_solution",
            # re-exported from lib.allocation, lib.model and lib.angles, where they are defined
            "allocate", "allocate_least_squares", "allocate_limited", "residual", "input_matrix", "wrap_angle"]
 
@@ -84,10 +84,32 @@ def computed_torque_from(body: Body, gains: Gains, z_d, dz_d, ddz_d, z, dz) -> n
     numpy.ndarray
         tau = [tau_x (N), tau_y (N), tau_phi (N m)], shape (..., 3).
     """
+    return demand(np.array([body.m, body.m, body.I]), body.drag, gains, z_d, dz_d, ddz_d, z, dz)
+
+
+def demand(mass, drag, gains: Gains, z_d, dz_d, ddz_d, z, dz) -> np.ndarray:
+    """Eq. (23) with the model's inertia M = diag(m, m, I_C) and drag N = diag(c, c, c_phi) given
+    as arrays, tau = M ddz_d + N dz + Kv (dz_d - dz) + Kp (z_d - z): the one statement of (23),
+    which :func:`computed_torque_from` calls with a body's values and a controller with a wrong
+    model per point (:mod:`lib.tracking.mismatch`) with its own.
+
+    Parameters
+    ----------
+    mass, drag : array_like
+        The diagonals of M (kg, kg, kg m^2) and N (kg/s, kg/s, kg m^2/s), (..., 3), broadcast.
+    gains : Gains
+        The gains Kp, Kv.
+    z_d, dz_d, ddz_d, z, dz : array_like
+        As in :func:`computed_torque_from`, (..., 3).
+
+    Returns
+    -------
+    numpy.ndarray
+        tau = [tau_x (N), tau_y (N), tau_phi (N m)], shape (..., 3).
+    """
     z = np.asarray(z, dtype=float)
     dz = np.asarray(dz, dtype=float)
-    m = np.array([body.m, body.m, body.I])
-    return m * ddz_d + body.drag * dz + gains.kv * (dz_d - dz) + gains.kp * (z_d - z)
+    return mass * ddz_d + drag * dz + gains.kv * (dz_d - dz) + gains.kp * (z_d - z)
 
 
 def computed_torque_rate(body: Body, gains: Gains, dz_d, ddz_d, dddz_d, dz, ddz) -> np.ndarray:

@@ -1,7 +1,7 @@
 """Physical and feedback parameters (the paper's Table 1, printed as "Table 5").
 
 Both classes are frozen dataclasses validated on construction (by
-:mod:`lib.checks`): a non-positive or non-finite value raises :class:`ValueError`
+:mod:`lib.machinery.checks`): a non-positive or non-finite value raises :class:`ValueError`
 and a value that is not a real number (a str, a bool) raises :class:`TypeError`,
 both naming the offending field (and the axis index for a gain).
 """
@@ -13,14 +13,21 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from . import checks
+from .machinery import checks
 
-__all__ = ["Body", "Gains", "PAPER_Z0", "PAPER_DZ0"]
+__all__ = ["Body", "Gains", "PAPER_Z0", "PAPER_DZ0", "BODY_RANGE"]
 
 #: The initial configuration of the paper's Table (x = 1 m, y = 0 m, phi = pi/2 rad).
 PAPER_Z0 = (1.0, 0.0, math.pi / 2)
 #: The initial velocities of the paper's Table (the body starts at rest).
 PAPER_DZ0 = (0.0, 0.0, 0.0)
+
+
+#: the range of each of the body's parameters (in SI units) that the book's methods serve:
+#: absolute tolerances (1e-10 and looser) on states of order one, explicit integrators whose
+#: steps scale with the ratios c/m, c_phi/I_C (``simulate`` refuses a run whose step count these
+#: ratios would blow up). A parameter 10^6 times the Table's or less than 10^-6 of it is outside.
+BODY_RANGE = (1e-6, 1e6)
 
 
 @dataclass(frozen=True)
@@ -45,7 +52,7 @@ class Body:
     TypeError
         If a value is not a real number (a str, a bool).
     ValueError
-        If a value is not positive and finite.
+        If a value is not positive and finite, or lies outside :data:`BODY_RANGE`.
     """
 
     m: float = 2.0
@@ -57,6 +64,10 @@ class Body:
     def __post_init__(self) -> None:
         for f in fields(self):
             value = checks.number(f"Body.{f.name}", getattr(self, f.name), positive=True)
+            lo, hi = BODY_RANGE
+            if not lo <= value <= hi:
+                raise ValueError(f"Body.{f.name} must lie in [{lo:g}, {hi:g}] (SI units), the range the "
+                                 f"book's integrators and tolerances are meant for; got {value!r}")
             object.__setattr__(self, f.name, value)
 
     @property

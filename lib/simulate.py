@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from . import checks
+from .machinery import checks
 from .allocation import Allocation, Limits
 from .closed_loop import ClosedLoop, reference_of
 from .integrators.smooth import Integration, SimulationError, integrate

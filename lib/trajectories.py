@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import checks
+from .machinery import checks
 
 __all__ = ["Reference", "Circle", "Eight", "circle", "eight", "make", "NAMES", "circle_kinematics",
            "eight_kinematics", "KINEMATICS", "circle_position", "eight_position", "position_kinematics", "POSITIONS",

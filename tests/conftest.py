@@ -14,14 +14,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lib.robustness import ROBUST_REL, perturbed
+from lib.machinery.robustness import ROBUST_REL, perturbed
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 # What the book is built from: a build of _build/ older than any of these is stale.
 # (README.md is not part of the book: _config.yml excludes it.)
-BOOK_INPUTS = ("chapters/*.md", "*.md", "_config.yml", "_toc.yml", "references.bib",
+BOOK_INPUTS = ("chapters/*.md", "*.md", "reference/*.md", "_config.yml", "_toc.yml", "references.bib",
                "lib/**/*.py", "_static/*", "_ext/*.py", "requirements.txt")
 BUILD_CMD = ["build", "--all", "-W", "-n", "--keep-going", "."]
 

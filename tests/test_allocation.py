@@ -7,7 +7,8 @@ from hypothesis import given, settings, strategies as st
 from hypothesis.extra.numpy import arrays
 
 from lib import control, model, trajectories
-from lib.allocation import Allocation, Limits, least_squares_problem, allocate, allocate_least_squares, allocate_limited, residual
+from lib.allocation import (Allocation, Limits, least_squares_problem, allocate, allocate_least_squares,
+                            allocate_limited, residual)
 from lib.params import Body, Gains
 from lib.simulate import Integration, simulate
 
@@ -185,8 +186,8 @@ def test_bound_allocation_is_the_public_law(tau, phi, law):
     (lambda: Allocation("least_squares", (0.0, 0.0, 0.0)), ValueError, "not all zero"),
     (lambda: Allocation().bind("body"), TypeError, "body must be"),
     (lambda: Allocation().bind(Body(), (4.0, 1.0)), TypeError, "limits must be"),
-    (lambda: Limits(force=0.0), ValueError, "force_limit"),
-    (lambda: Limits(angle=4.0), ValueError, "angle_limit"),
+    (lambda: Limits(force=0.0), ValueError, "^force must"),
+    (lambda: Limits(angle=4.0), ValueError, "^angle must"),
 ])
 def test_allocation_and_limits_validate_on_construction(make, exc, msg):
     with pytest.raises(exc, match=msg):

@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from lib import trajectories as T, weighting
+from lib import trajectories as T
+from lib.weighting import comparison as weighting
 from lib.allocation import Allocation, Limits
 from lib.simulate import Integration
 from lib.params import PAPER_DZ0, PAPER_Z0, Body, Gains

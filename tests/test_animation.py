@@ -6,7 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from lib import animation, tracking
+from lib.figures import animation
+from lib.tracking import runs as tracking
 from lib.params import Body, Gains
 
 

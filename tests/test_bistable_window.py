@@ -1,5 +1,5 @@
 """The circle's bistable window (issue 19): the homoclinic edge R_edge of the corrected
-(33) found by shooting (lib.circle_rotation.bistable_window), checked against long runs
+(33) found by shooting (lib.rotation.circle_global.bistable_window), checked against long runs
 of (33) on either side, against the damped pendulum with constant torque in normalised
 form (its own shooting), and against Melnikov's weak-torque limit."""
 
@@ -10,8 +10,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from lib.angles import wrap_angle
-from lib.circle_rotation import (bistable_window, circle_equilibria, circle_rotation_rhs,
-                                 torque_pendulum_threshold, window_closing_rate)
+from lib.rotation.circle_global import bistable_window, torque_pendulum_threshold, window_closing_rate
+from lib.rotation.circle import circle_equilibria, circle_rotation_rhs
 from lib.params import Body
 
 BODY = Body()

@@ -1,4 +1,4 @@
-"""lib.book_cache: one computation shared by two pages of one build, never a stale one."""
+"""lib.machinery.cache: one computation shared by two pages of one build, never a stale one."""
 
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -6,7 +6,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pytest
 
-from lib import book_cache
+from lib.machinery import cache as book_cache
 
 
 CALLS = []

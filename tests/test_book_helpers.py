@@ -1,4 +1,4 @@
-"""lib.book's helpers for the notebooks: the Markdown tables they emit parse back to
+"""lib.machinery.glue's helpers for the notebooks: the Markdown tables they emit parse back to
 the frame's columns and cells (read by markdown-it, the parser MyST uses)."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import pandas as pd
 import pytest
 
-from lib.book import markdown_table
+from lib.machinery.glue import markdown_table
 
 markdown_it = pytest.importorskip("markdown_it")
 dollarmath = pytest.importorskip("mdit_py_plugins.dollarmath")
@@ -54,7 +54,7 @@ def test_markdown_table_with_index_adds_the_index_as_first_column():
 
 
 def test_with_alt_gives_every_image_without_one_the_alt_text():
-    from lib.book import with_alt
+    from lib.machinery.glue import with_alt
 
     snippet = '<div><img id="a" src="x.png"><img alt="kept" src="y.png"><IMG\nsrc="z"></div>'
     out = with_alt(snippet, 'The body "tracking" a circle.')

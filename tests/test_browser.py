@@ -106,7 +106,7 @@ def prose_of(source: str) -> str:
 
 def expected_tables(doc: str) -> int:
     """Tables the page must show: the Markdown tables of its text and those its cells emit
-    as Markdown (``lib.book.markdown_table``), read from the executed notebook."""
+    as Markdown (``lib.machinery.glue.markdown_table``), read from the executed notebook."""
     n = count_markdown_tables(prose_of((ROOT / f"{doc}.md").read_text()))
     nb = BUILD / "jupyter_execute" / f"{doc}.ipynb"
     if nb.exists():
@@ -288,9 +288,9 @@ def _english_none(text: str, start: int, end: int) -> bool:
     return (not before or before[-1] in ".!?\n") and re.match(r" [a-z]", text[end:]) is not None
 
 
-#: pages generated from the library's docstrings (reference.md): None and NaN there are
-#: words of the API (defaults, return values), not missing values; they glue nothing
-API_DOCS = ("reference",)
+#: pages generated from the library's docstrings (reference.md and its pages): None and NaN
+#: there are words of the API (defaults, return values), not missing values; they glue nothing
+API_DOCS = tuple(d for d in DOCS if d == "reference" or d.startswith("reference/"))
 
 
 @pytest.mark.parametrize("doc", [d for d in DOCS if d not in API_DOCS])

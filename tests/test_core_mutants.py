@@ -292,16 +292,23 @@ def test_limited_allocation_does_not_admit_an_optimum_behind_the_body_of_unit_si
 def test_limits_are_stored_as_floats_and_name_the_limit_in_their_errors():
     lim = Limits(force=3, angle=np.float32(0.5))
     assert type(lim.force) is float and type(lim.angle) is float
-    with pytest.raises(ValueError, match=r"^force_limit must be positive, got -1"):
+    with pytest.raises(ValueError, match=r"^force must be positive, got -1"):
         Limits(force=-1.0)
-    with pytest.raises(ValueError, match=r"^angle_limit must be at most 3\.14"):
+    with pytest.raises(ValueError, match=r"^angle must be at most 3\.14"):
         Limits(angle=4.0)
+    with pytest.raises(TypeError, match=r"^force must be a real number"):
+        Limits(force="3")
+    # the functions that take the limits as force_limit / angle_limit name those
+    with pytest.raises(ValueError, match=r"^force_limit must be positive, got -1"):
+        A.allocate(np.ones(3), 0.0, force_limit=-1.0)
+    with pytest.raises(ValueError, match=r"^angle_limit must be at most 3\.14"):
+        A.allocate_limited(np.ones(3), 0.0, Body(), angle_limit=4.0)
 
 
 @pytest.mark.parametrize("kw", [{"force": True}, {"angle": True}, {"force": np.array([3.0])},
                                 {"angle": [0.5]}, {"angle": np.array(0.5)[None]}])
 def test_limits_reject_a_bool_or_an_array(kw):
-    with pytest.raises(TypeError, match="_limit must be a real number"):
+    with pytest.raises(TypeError, match=rf"^{next(iter(kw))} must be a real number"):
         Limits(**kw)
 
 
@@ -394,7 +401,7 @@ def test_computed_torque_names_a_wrong_argument(args, exc, message):
     lambda phi, tau, w: A.allocate_least_squares(tau, phi, Body(), w),
 ])
 def test_a_non_finite_argument_of_an_allocation_is_named(call):
-    # the messages start with the argument's name (lib/checks.py): phi, tau, weights
+    # the messages start with the argument's name (lib/machinery/checks.py): phi, tau, weights
     good_tau, good_w = np.array([1.0, 0.5, 0.2]), (1.0, 1.0, 0.0)
     with pytest.raises(ValueError, match=r"^phi\b"):
         call(np.nan, good_tau, good_w)

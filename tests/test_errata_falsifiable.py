@@ -19,8 +19,8 @@ import sympy as sp
 from lib.controllability import paper_bracket_count, witt_dimension
 from lib.paper import errata, model_errata, reading_errata as rd
 from lib.paper.rotation_errata import CORRECTED_HEADING_SERIES
-from lib.rotation_equations import (corrected_p0, derive_eight_equation, derive_rotation_equation, printed_eq33,
-                                    printed_eq37, printed_p0)
+from lib.rotation.equations import (corrected_p0, derive_eight_equation, derive_rotation_equation,
+                                    printed_eq33, printed_eq37, printed_p0)
 from lib.symbolic import (derive_body_frame, evaluate_bracket, model_fields, printed_brackets, printed_drift,
                           rank_determinants)
 from lib.trajectories import PAPER_HEADING_SERIES

@@ -1,7 +1,7 @@
 """Tight bounds on the compiled switched integrator against the event-located reference.
 
 ``tests/test_limits.py`` checks that the compiled fixed-step integrator
-(:mod:`lib.integrators.switched_compiled`, through :func:`lib.limits.switched_runs`)
+(:mod:`lib.integrators.switched_compiled`, through :func:`lib.limits.runs.switched_runs`)
 agrees with the adaptive, event-located :class:`lib.integrators.switched.SwitchedLoop`
 to 1e-5, a bound that proves the two integrate the same system. These tests bound the
 agreement at a few times what it is today, so that a loss of accuracy in locating the
@@ -20,7 +20,8 @@ import math
 import numpy as np
 import pytest
 
-from lib import limits as L, trajectories as T
+from lib.limits import verdicts as L
+from lib import trajectories as T
 from lib.params import Body, Gains
 
 S0 = np.array([1.0, 0.0, math.pi / 2, 0.0, 0.0, 0.0])

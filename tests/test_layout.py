@@ -10,9 +10,9 @@ import pytest
 LIB = Path(__file__).resolve().parents[1] / "lib"
 
 #: function-local imports of lib modules, each with the cost that justifies it
-LOCAL_IMPORTS_ALLOWED = {("lib.rotation", "lib.integrators.compiled"),               # numba's import and compile
-                         ("lib.rotation_engine", "lib.integrators.compiled"),
-                         ("lib.switched_runs", "lib.integrators.switched_compiled")}
+LOCAL_IMPORTS_ALLOWED = {("lib.rotation.reduced", "lib.integrators.compiled"),       # numba's import and compile
+                         ("lib.rotation.engine", "lib.integrators.compiled"),
+                         ("lib.limits.runs", "lib.integrators.switched_compiled")}
 
 
 def _module_name(path: Path) -> str:
@@ -98,7 +98,7 @@ def test_the_model_core_depends_on_nothing_above_it(core):
     # the core (params, model, trajectories, control, allocation, closed loop) never reaches up
     # into the integrators, the analyses, the figures or the verdicts
     g, _ = _graph()
-    below = {"lib", "lib.checks", "lib.params", "lib.angles", "lib.model", "lib.trajectories", "lib.allocation",
+    below = {"lib", "lib.machinery", "lib.machinery.checks", "lib.params", "lib.angles", "lib.model", "lib.trajectories", "lib.allocation",
              "lib.control", "lib.closed_loop"}
     assert _descendants(g, core) <= below, sorted(_descendants(g, core) - below)
 
@@ -109,7 +109,8 @@ def test_the_parser_sees_relative_and_local_imports():
     assert "lib.integrators.switched" in g["lib.simulate"]        # from .integrators.switched import
     assert "lib.trajectories" in g["lib.integrators.switched"]     # from ..trajectories import
     assert "lib.paper.model_errata" in g["lib.paper.errata"]       # from . import model_errata
-    assert ("lib.rotation", "lib.integrators.compiled") in local
+    assert "lib.machinery.checks" in g["lib.params"]               # from .machinery import checks
+    assert ("lib.rotation.reduced", "lib.integrators.compiled") in local
 
 
 def test_modules_and_functions_stay_a_size_a_reader_can_hold():
@@ -129,3 +130,38 @@ def test_modules_and_functions_stay_a_size_a_reader_can_hold():
                     long_functions.append((path.name, node.name, node.end_lineno - first + 1))
     assert not long_modules, long_modules
     assert not long_functions, long_functions
+
+
+#: the most modules a folder (the top of lib included) holds, its __init__ aside: a reader takes
+#: in a folder at a glance. The top holds the model core every chapter uses, and two public faces
+#: kept where readers' scripts import them (lib.symbolic, lib.controllability, lib.stability).
+MAX_MODULES_PER_FOLDER = 11
+
+
+def test_each_folder_holds_few_modules_and_says_which_part_of_the_book_it_serves():
+    folders = [LIB] + sorted(p for p in LIB.iterdir() if p.is_dir() and (p / "__init__.py").exists())
+    assert len(folders) > 8
+    for folder in folders:
+        modules = [p for p in folder.glob("*.py") if p.name != "__init__.py"]
+        assert 0 < len(modules) <= MAX_MODULES_PER_FOLDER, (folder.name, len(modules))
+        doc = ast.get_docstring(ast.parse((folder / "__init__.py").read_text()))
+        assert doc and len(doc) > 80, f"{folder.name}/__init__.py needs a docstring saying what it holds"
+
+
+def test_module_names_inside_a_folder_drop_the_folder_s_prefix():
+    for folder in (p for p in LIB.iterdir() if p.is_dir() and (p / "__init__.py").exists()):
+        stem = folder.name.rstrip("s")
+        offenders = [p.name for p in folder.glob("*.py") if p.stem.startswith(stem + "_")]
+        assert not offenders, (folder.name, offenders)
+
+
+def test_a_face_package_re_exports_and_every_other_init_only_documents():
+    # the public faces re-export the names readers import (issue 21's stable names among them);
+    # every other folder's __init__ holds a docstring and, at most, imports of its own modules
+    faces = {"tracking", "limits", "rotation", "weighting", "dynamics", "integrators", "paper"}
+    for folder in (p for p in LIB.iterdir() if p.is_dir() and (p / "__init__.py").exists()):
+        tree = ast.parse((folder / "__init__.py").read_text())
+        defs = [n for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef))]
+        assert not defs, f"{folder.name}/__init__.py defines code; it belongs in a module"
+        if folder.name not in faces:
+            assert not [n for n in tree.body if isinstance(n, (ast.Import, ast.ImportFrom))], folder.name

@@ -1,6 +1,6 @@
 """The mirror symmetry of the closed loop under the limits on the eight, the attractors
 starts reach with their mirrors, and the Lyapunov exponent's independence of d0
-(lib.limit_attractors, Chapter 4)."""
+(lib.limits.attractors, Chapter 4)."""
 
 import math
 
@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 from hypothesis import assume, given, settings, strategies as st
 
-from lib import limit_attractors as la, limits as L, trajectories as T
+from lib.limits import attractors as la, verdicts as L
+from lib import trajectories as T
 from lib.allocation import Limits
 from lib.angles import wrap_angle
 from lib.closed_loop import ClosedLoop, reference_of

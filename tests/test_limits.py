@@ -5,7 +5,8 @@ import pytest
 from hypothesis import given, settings, strategies as st_
 
 from flows import damped_oscillator_flow, driven_pendulum_flow
-from lib import limits as L, trajectories as T
+from lib.limits import verdicts as L
+from lib import trajectories as T
 from lib.params import Body, Gains
 from lib.allocation import Limits
 from lib.closed_loop import ClosedLoop, reference_of

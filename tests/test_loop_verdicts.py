@@ -1,14 +1,15 @@
-"""One verdict for both laws (Chapter 6): :func:`lib.weighting.closed_loop_verdicts` on the full
+"""One verdict for both laws (Chapter 6): :func:`lib.weighting.verdicts.closed_loop_verdicts` on the full
 closed loop, against Chapter 5's verdicts on the reduced rotation (32) and a long adaptive run."""
 
 import numpy as np
 import pytest
 
-from lib import loop_verdicts, trajectories as T, weighting
+from lib.weighting import verdicts as loop_verdicts, comparison as weighting
+from lib import trajectories as T
 from lib.allocation import Allocation, Limits
 from lib.closed_loop import ClosedLoop
 from lib.params import Body, Gains
-from lib.rotation_verdicts import REGIMES, rotation_verdicts
+from lib.rotation.verdicts import REGIMES, rotation_verdicts
 from lib.simulate import Integration, simulate
 
 # three decided points of Chapter 5's map of the eight (the grid of Chapter 6's map): a strongly

@@ -1,5 +1,5 @@
 """A wrong model (issue 19 part 4): the closed loop with the controller's model off
-(lib.mismatch, the ``model=`` of ClosedLoop and simulate)."""
+(lib.tracking.mismatch, the ``model=`` of ClosedLoop and simulate)."""
 
 import math
 
@@ -9,13 +9,13 @@ import pytest
 import sympy as sp
 
 from lib.closed_loop import ClosedLoop, reference_of
-from lib.loop_verdicts import closed_loop_verdicts
-from lib.mismatch import (PARAMETERS, _MismatchFlow, error_equation, influence, linear_position_error,
-                          mismatch_study, mismatch_sweep, model_of)
-from lib.parallel import process_pool
+from lib.weighting.verdicts import closed_loop_verdicts
+from lib.tracking.mismatch import (PARAMETERS, _MismatchFlow, error_equation, influence,
+                                   linear_position_error, mismatch_study, mismatch_sweep, model_of)
+from lib.machinery.parallel import process_pool
 from lib.params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from lib.simulate import Integration, simulate
-from lib.tracking import mismatch_sweep as reexported
+from lib.tracking.mismatch import mismatch_sweep as reexported
 from lib.trajectories import circle, make
 
 BODY, GAINS = Body(), Gains()

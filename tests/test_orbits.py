@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from lib import rotation, stability
+from lib.rotation import reduced as rotation
+from lib import stability
 from lib.dynamics import orbits
 from lib.params import Body
 

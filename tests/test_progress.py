@@ -1,5 +1,5 @@
 """Long sweeps report progress (a tqdm bar on stderr) when run interactively or when asked,
-and stay quiet under pytest and in the book build (lib.parallel.show_progress)."""
+and stay quiet under pytest and in the book build (lib.machinery.parallel.show_progress)."""
 
 import io
 import sys
@@ -8,9 +8,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from lib import parallel
+from lib.machinery import parallel
 from lib.params import Body
-from lib.rotation_verdicts import eight_rotation_sweep
+from lib.rotation.verdicts import eight_rotation_sweep
 
 
 class _Terminal(io.StringIO):

@@ -1,4 +1,4 @@
-"""Decisive verdicts on the rotation (lib.rotation_verdicts, lib.integrators.compiled.rotation_flow)."""
+"""Decisive verdicts on the rotation (lib.rotation.verdicts, lib.integrators.compiled.rotation_flow)."""
 
 import math
 
@@ -6,7 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from lib import rotation, rotation_attractor as attractor, rotation_verdicts as verdicts, simulate, trajectories
+from lib.rotation import reduced as rotation, attractor, verdicts
+from lib import simulate, trajectories
 from lib.integrators import batch, compiled
 from lib.params import Body, Gains
 
@@ -197,7 +198,7 @@ def test_bad_kind_and_bad_attractor_input():
 
 
 def test_fused_rates_of_the_compiled_variational_equation_are_the_two_definitions_bit_for_bit():
-    from lib.rotation_field import rotation_rates, rotation_rates_dphi, rotation_rates_with_dphi
+    from lib.rotation.field import rotation_rates, rotation_rates_dphi, rotation_rates_with_dphi
 
     rng = np.random.default_rng(11)
     phi, w, A, B, C, X1, Y1, X2, Y2 = rng.uniform(-5, 5, (9, 1000))

@@ -1,5 +1,5 @@
 """Scale-out: every sweep sends its points in chunks to any concurrent.futures.Executor
-(lib.parallel.map_chunks) and gives back exactly the frame of the single-process run; a
+(lib.machinery.parallel.map_chunks) and gives back exactly the frame of the single-process run; a
 dask cluster is one such executor; processes are spawned, so a pool works after numba's
 threads have run in this process."""
 
@@ -11,17 +11,18 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from lib import limits as L
-from lib import loop_verdicts as LV
-from lib import weighting as W
+from lib.limits import verdicts as L
+from lib.weighting import verdicts as LV
+from lib.weighting import comparison as W
 from lib import trajectories as T
 from lib.allocation import Limits
 from lib.angles import wrap_angle
-from lib.parallel import chunk_slices, concat_frames, executor_workers, map_chunks, map_in_processes, process_pool
+from lib.machinery.parallel import (chunk_slices, concat_frames, executor_workers, map_chunks,
+                                    map_in_processes, process_pool)
 from lib.params import Body, Gains
-from lib.rotation_verdicts import FIG5_GRID
+from lib.rotation.verdicts import FIG5_GRID
 from lib.stability import eight_rotation_sweep
-from lib.tracking import eight_sensitivity, force_cap_sweep
+from lib.tracking.runs import eight_sensitivity, force_cap_sweep
 
 
 def _grid(n):
@@ -178,3 +179,29 @@ def test_tracking_sweeps_through_a_process_pool_are_the_single_call(pool):
                                   check_exact=True)
     with pytest.raises(ValueError, match="not both"):
         eight_sensitivity(Body(), Gains(), [1.0, 2.0], [0.5], workers=2, executor=pool, **s)
+
+
+_SCRIPT = """
+import math
+from lib.machinery.parallel import map_in_processes
+{body}
+"""
+
+
+@pytest.mark.parametrize("guarded", [False, True])
+def test_worker_processes_from_an_unguarded_script_fail_at_once_naming_the_fix(tmp_path, guarded):
+    # spawned workers import the script again: without the guard its body would run in each of
+    # them and multiprocessing would print pages of "bootstrapping phase" tracebacks
+    import subprocess
+    import sys
+    call = "print(map_in_processes(math.sqrt, [1.0, 4.0, 9.0], workers=2))"
+    body = f'if __name__ == "__main__":\n    {call}' if guarded else call
+    script = tmp_path / "sweep.py"
+    script.write_text(_SCRIPT.format(body=body))
+    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120)
+    if guarded:
+        assert out.returncode == 0 and out.stdout.strip() == "[1.0, 2.0, 3.0]", out.stderr
+    else:
+        assert out.returncode != 0
+        assert 'if __name__ == "__main__":' in out.stderr and "sweep.py, line 4" in out.stderr
+        assert "bootstrapping" not in out.stderr and out.stderr.count("Traceback") == 1

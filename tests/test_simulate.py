@@ -84,9 +84,9 @@ def test_simulate_rejects_bad_input(kw, exc, msg):
 
 
 @pytest.mark.parametrize("make,msg", [
-    (lambda: Limits(force=-1.0), "force_limit"),
-    (lambda: Limits(angle=7.0), "angle_limit"),
-    (lambda: Limits(force=np.nan), "force_limit"),
+    (lambda: Limits(force=-1.0), "^force must"),
+    (lambda: Limits(angle=7.0), "^angle must"),
+    (lambda: Limits(force=np.nan), "^force must"),
     (lambda: Integration(rtol=0.0), "rtol"),
     (lambda: Integration(atol=np.nan), "atol"),
     (lambda: Integration(switching="magic"), "switching"),

@@ -1,7 +1,7 @@
-"""Slow eights (lib.slow_eight, Chapter 5): the frozen equilibrium of the osculating
+"""Slow eights (lib.rotation.slow_eight, Chapter 5): the frozen equilibrium of the osculating
 circle, the boundary r_follow where it ceases to exist, and the overdamped heading's
 periodic solution with its first inertia correction, against the decided orbits of
-the reduced rotation (37) (lib.rotation_verdicts, lib.dynamics.verdicts).
+the reduced rotation (37) (lib.rotation.verdicts, lib.dynamics.verdicts).
 
 The decided orbits compared here are period-1 orbits with Floquet multipliers below
 1e-10 in modulus, located by Newton to 1e-10 rad with ranges good to about 1e-7 rad:
@@ -13,11 +13,11 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize_scalar
 
-from lib.circle_rotation import circle_equilibria
+from lib.rotation.circle import circle_equilibria
 from lib.params import Body
-from lib.rotation import slow_eight_prediction
-from lib.rotation_verdicts import rotation_verdicts
-from lib.slow_eight import follow_radius, frozen_heading, series_peak_curvature, unit_eight_geometry
+from lib.rotation.slow_eight import slow_eight_prediction
+from lib.rotation.verdicts import rotation_verdicts
+from lib.rotation.slow_eight import follow_radius, frozen_heading, series_peak_curvature, unit_eight_geometry
 from lib.trajectories import eight_kinematics
 
 BODY = Body()

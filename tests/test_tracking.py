@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from lib import control, model, tracking as TR, trajectories as T
+from lib import control, model, trajectories as T
+from lib.tracking import runs as TR
 from lib.allocation import Limits
 from lib.params import Body, Gains
 from lib.simulate import Integration, simulate

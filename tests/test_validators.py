@@ -1,4 +1,4 @@
-"""One way to check inputs (lib.checks): every public entry point rejects a str, a bool or
+"""One way to check inputs (lib.machinery.checks): every public entry point rejects a str, a bool or
 a NaN where a number belongs with an error naming the argument (TypeError for a wrong type,
 ValueError for a wrong value), and a NaN inside an array with its index. And the weighted
 allocation with a zero weight (w_x w_y = 0) runs instead of failing the batch's SVD."""
@@ -10,7 +10,11 @@ import pytest
 import sympy as sp
 
 from lib import allocation as A
-from lib import checks, control, limits, loop_verdicts, stability, symbolic, tracking, weighting
+from lib.machinery import checks
+from lib import control, stability, symbolic
+from lib.limits import verdicts as limits
+from lib.weighting import verdicts as loop_verdicts, comparison as weighting
+from lib.tracking import runs as tracking
 from lib import trajectories as T
 from lib.allocation import Limits
 from lib.dynamics.verdicts import REGIMES
@@ -97,8 +101,8 @@ SCALARS = [
     ("Gains.kp", lambda v: Gains(kp=v), r"Gains\.kp"),
     ("circle R", lambda v: T.circle(v, 0.5), r"\bR\b"),
     ("eight theta", lambda v: T.eight(2.0, v), r"\btheta\b"),
-    ("Limits force", lambda v: Limits(force=v), "force_limit"),
-    ("Limits angle", lambda v: Limits(angle=v), "angle_limit"),
+    ("Limits force", lambda v: Limits(force=v), r"^force\b"),
+    ("Limits angle", lambda v: Limits(angle=v), r"^angle\b"),
     ("allocate force_limit", lambda v: control.allocate(TAU, 0.0, force_limit=v), "force_limit"),
     ("allocate_limited angle_limit", lambda v: control.allocate_limited(TAU, 0.0, BODY, angle_limit=v),
      "angle_limit"),

@@ -7,13 +7,16 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from lib import limits, loop_verdicts, rotation_verdicts, stability
+from lib.limits import verdicts as limits
+from lib.weighting import verdicts as loop_verdicts
+from lib.rotation import verdicts as rotation_verdicts
+from lib import stability
 from lib.angles import wrap_angle
-from lib.circle_rotation import circle_critical_radius, circle_eigenvalues
+from lib.rotation.circle import circle_critical_radius, circle_eigenvalues
 from lib.dynamics import verdicts as dv
 from lib.params import Body
-from lib.rotation_engine import RotationMap, _Engine
-from lib.rotation_field import coefficients
+from lib.rotation.engine import RotationMap, _Engine
+from lib.rotation.field import coefficients
 
 BODY = Body()
 

@@ -1,4 +1,4 @@
-"""The circle's steady motion under the weighted allocation (lib.weighted_circle), each
+"""The circle's steady motion under the weighted allocation (lib.weighting.circle), each
 property checked by an independent route: Chapter 5's closed form, a linearisation by
 simulation, simulations on both sides of the limit, and frames taken at other times."""
 
@@ -7,15 +7,16 @@ import math
 import numpy as np
 import pytest
 
-from lib import trajectories, weighting
+from lib import trajectories
+from lib.weighting import comparison as weighting
 from lib.allocation import Allocation
-from lib.circle_rotation import circle_critical_radius, circle_eigenvalues, circle_equilibria
+from lib.rotation.circle import circle_critical_radius, circle_eigenvalues, circle_equilibria
 from lib.integrators.smooth import Integration
 from lib.params import Body, Gains
 from lib.simulate import simulate
-from lib.weighted_circle import (LIMIT_KINDS, circle_error_weight, circle_steady_state, circle_weight_limit,
-                                 circle_weight_sweep, inertial_to_rotating, rotating_field, rotating_to_inertial,
-                                 _jacobian, _loop)
+from lib.weighting.circle import (LIMIT_KINDS, circle_error_weight, circle_steady_state, circle_weight_limit,
+                                  circle_weight_sweep, rotating_field, _jacobian, _loop)
+from lib.weighting.rotating_frame import inertial_to_rotating, rotating_to_inertial
 
 BODY, GAINS, R, THETA = Body(), Gains(), 2.0, math.pi / 4
 

@@ -12,7 +12,7 @@ DP^k at the orbit are its Floquet multipliers: the orbit attracts when all lie
 inside the unit circle.
 
 :func:`newton_orbit` works on any map given with its Jacobian, vectorised over
-points; :func:`lib.rotation.rotation_period_map` is the period map of the reduced rotation
+points; :func:`lib.rotation.reduced.rotation_period_map` is the period map of the reduced rotation
 equation (32) on the eight (28) or the circle (27), integrated with the same
 fixed-step 8th-order Dormand-Prince scheme as the Fig. 5 sweep
 (:func:`lib.stability.rotation_sweep`), its Jacobian by integrating the

@@ -48,7 +48,7 @@ from typing import Callable
 
 import numpy as np
 
-from .orbit_search import (PeriodMap, difference_jacobian, distance_to_orbit, enclosed_orbit, lag_candidates,  # re-exported
+from .orbit_search import (PeriodMap, difference_jacobian, distance_to_orbit, enclosed_orbit, lag_candidates,
                            least_period, orbit_points, reached)
 from .orbits import NewtonResult, floquet_multipliers, newton
 from .statistics import batch_means, block_statistics, drift_statistics, section_returns  # re-exported

@@ -3,7 +3,7 @@ parameter points at once.
 
 Every point takes the same steps, so the states of N points are one array and each
 stage is one vectorised evaluation of the field. Used for the closed loop over a
-map of (R, Theta) (Chapter 6, :func:`lib.weighting.closed_loop_batch`, classical
+map of (R, Theta) (Chapter 6, :func:`lib.weighting.batch.closed_loop_batch`, classical
 RK4) and for the reduced rotation equation over the Fig. 5 grid
 (:mod:`lib.rotation`, 8th-order Dormand-Prince), whose compiled engine runs this
 same scheme in numba loops.

@@ -1,7 +1,7 @@
 """The compiled engine of the batch integrator for the reduced rotation equation: the
 fixed-step scheme of :func:`lib.integrators.batch.steps` (8th-order Dormand-Prince)
 run over one reference period, one point per parallel numba loop, on the field
-:func:`lib.rotation_field.rotation_rates` compiled from its one definition. About
+:func:`lib.rotation.field.rotation_rates` compiled from its one definition. About
 ten times faster than the vectorised numpy engine on the Fig. 5 grid (see
 ``benchmarks/bench_eight_sweep.py``); the tests check the two agree to rounding.
 """
@@ -11,7 +11,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ..rotation_field import rotation_rates, rotation_rates_with_dphi
+from ..rotation.field import rotation_rates, rotation_rates_with_dphi
 
 __all__ = ["rotation_period", "rotation_flow"]
 
@@ -150,11 +150,11 @@ def _flow_kernel(phi, w, J, A, B, C, periods, X1, Y1, X2, Y2, hA, hB, jac, renor
 def rotation_flow(phi, w, A, B, C, periods, X1, Y1, X2, Y2, hA, hB, *, J=None, jac: bool = True,
                   renorm: bool = False, H=None, wind2pi: float = 0.0):
     """``periods`` (int, or one per point) reference periods of the reduced rotation
-    equation (32) in the phase form of :func:`lib.rotation_field.rotation_rates`, for N
+    equation (32) in the phase form of :func:`lib.rotation.field.rotation_rates`, for N
     points in parallel, by the fixed-step scheme of :func:`rotation_period` (the unit
     reference's derivatives tabulated at the stage phases, (n steps, stages); ``hA``,
     ``hB`` the tableau times the step). With ``jac`` the variational equation (its
-    phi-derivative from :func:`lib.rotation_field.rotation_rates_with_dphi`) is run with the
+    phi-derivative from :func:`lib.rotation.field.rotation_rates_with_dphi`) is run with the
     same stages, so J is the exact Jacobian of the discrete map. ``J`` (N, 2, 2) is the
     initial variational matrix (identity by default). With ``renorm`` its first column
     is a tangent vector renormalised every period (for the largest Lyapunov exponent); the

@@ -432,7 +432,7 @@ def _run(P, bmax, fmax, S0, n_periods, n_steps, T, t0, lyap_from, d0, A, b, c, s
 def run_periods(P: np.ndarray, angle_limits: np.ndarray, force_limits: np.ndarray, S0: np.ndarray, n_periods: int,
                 steps_per_period: int, period: float, t0: float, lyapunov_from: int, d0: float, A: np.ndarray,
                 b: np.ndarray, c: np.ndarray):
-    """Low-level entry (see :func:`lib.limits.switched_runs` for the checked one): N runs
+    """Low-level entry (see :func:`lib.limits.runs.switched_runs` for the checked one): N runs
     of ``n_periods`` periods from states S0 (N, 6) at t0. Returns the states at the period
     ends (N, n_periods + 1, 6), the final modes (N,), log(d/d0) of the companion per
     period from ``lyapunov_from`` on (N, n_periods - lyapunov_from; -1 for none) and the

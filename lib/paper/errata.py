@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from ..book_cache import cached
+from ..machinery.cache import cached
 from . import model_errata, reading_errata, rotation_errata, tracking_errata
 from .verdicts import Erratum, Verdict
 
@@ -42,7 +42,7 @@ def rows() -> list[Erratum]:
 
 def verdict(key: str) -> Verdict:
     """The verdict of the row ``key``'s check. In a book build it is computed once per state
-    of the library (:func:`lib.book_cache.cached`) and shared by the errata page, the
+    of the library (:func:`lib.machinery.cache.cached`) and shared by the errata page, the
     report, Chapter 5 and the tests run beside the build; elsewhere it is simply computed."""
     return cached(_check_row, key)
 

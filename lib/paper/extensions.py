@@ -2,7 +2,7 @@
 answers the paper left open (issue 19), each decided by the computation its chapter shows.
 
 Each check recomputes its evidence or, where the chapter's computation is expensive, reads it
-through :func:`lib.book_cache.cached` with the chapter's own arguments (computed once per build
+through :func:`lib.machinery.cache.cached` with the chapter's own arguments (computed once per build
 and shared with the chapter). A check decides between ``extended`` and ``not reproducible``
 and says in its note which condition it tested; the thresholds are margins on values measured
 in the chapters, written beside each.
@@ -14,15 +14,16 @@ import math
 
 import numpy as np
 
-from ..book_cache import cached
-from ..circle_rotation import bistable_window, torque_pendulum_threshold, window_closing_rate
-from ..limit_attractors import heading_offset_starts, lyapunov_horizons, mirror_defect, mirrored_start, start_attractors
-from ..mismatch import mismatch_study
+from ..machinery.cache import cached
+from ..rotation.circle_global import bistable_window, torque_pendulum_threshold, window_closing_rate
+from ..limits.attractors import (heading_offset_starts, lyapunov_horizons, mirror_defect, mirrored_start,
+                                 start_attractors)
+from ..tracking.mismatch import mismatch_study
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
-from ..rotation_verdicts import fig5_map
-from ..slow_eight import slow_eight_prediction
+from ..rotation.verdicts import fig5_map
+from ..rotation.slow_eight import slow_eight_prediction
 from ..trajectories import eight
-from ..weighted_circle import circle_steady_state, circle_weight_limit
+from ..weighting.circle import circle_steady_state, circle_weight_limit
 from .outcomes import Item, Outcome, decide
 
 __all__ = ["items"]

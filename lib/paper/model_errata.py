@@ -10,9 +10,9 @@ import sympy as sp
 
 from ..controllability import (free_lie_rank, paper_bracket_count, rest_report, right_nested,
                                strong_accessibility_det, sussmann_check, witt_dimension)
-from ..symbolic import (Bracket, _slug, _symbols_only, accessibility_matrix, bracket_latex, compare_printed_brackets,
-                        derive_body_frame, evaluate_bracket, lie_bracket, model_fields, printed_brackets,
-                        printed_drift, rank_determinants)
+from ..symbolic import (Bracket, _slug, _symbols_only, accessibility_matrix, bracket_latex,
+                        compare_printed_brackets, derive_body_frame, evaluate_bracket, lie_bracket,
+                        model_fields, printed_brackets, printed_drift, rank_determinants)
 from ..params import Body
 from .verdicts import Erratum, Verdict
 

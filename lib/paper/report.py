@@ -25,22 +25,23 @@ import pandas as pd
 import sympy as sp
 from scipy.optimize import brentq, minimize_scalar
 
-from ..circle_rotation import (circle_critical_radius, circle_eigenvalues, circle_equilibria, circle_jacobian,
-                               circle_rotation_rhs, circle_slipping_coexists)
+from ..rotation.circle import (circle_critical_radius, circle_eigenvalues, circle_equilibria,
+                               circle_jacobian, circle_rotation_rhs)
+from ..rotation.circle_global import circle_slipping_coexists
 from ..allocation import Limits, allocate_limited
 from ..control import allocate, allocate_least_squares, error_dynamics_solution
 from ..controllability import free_lie_rank, paper_bracket_count
-from ..limits import extend_undecided, limit_verdicts
+from ..limits.verdicts import extend_undecided, limit_verdicts
 from ..model import f, generalized_force
 from ..params import Body, Gains
-from ..rotation_attractor import map_summary, rotation_attractor
-from ..rotation_verdicts import FIG5_GRID, fig5_map
-from ..rotation_equations import derive_rotation_equation
+from ..rotation.attractor import map_summary, rotation_attractor
+from ..rotation.verdicts import FIG5_GRID, fig5_map
+from ..rotation.equations import derive_rotation_equation
 from ..simulate import OPEN_LOOP_HORIZON, Integration, open_loop_comparison, simulate
 from ..symbolic import derive_body_frame, rank_determinants
-from ..tracking import steady_summary
+from ..tracking.runs import steady_summary
 from ..trajectories import circle, eight, eight_heading_fourier
-from ..book_cache import cached
+from ..machinery.cache import cached
 from .errata import rows, verdict
 from .extensions import items as extension_items
 from .outcomes import STATUSES, Item, Outcome, decide
@@ -434,7 +435,7 @@ def items() -> list[Item]:
 
 def outcome(key: str) -> Outcome:
     """The outcome of the row ``key``'s check. In a book build it is computed once per state
-    of the library (:func:`lib.book_cache.cached`) and shared by the report page and the
+    of the library (:func:`lib.machinery.cache.cached`) and shared by the report page and the
     tests run beside the build; elsewhere it is simply computed."""
     return cached(_check_item, key)
 

@@ -7,8 +7,8 @@ from __future__ import annotations
 import sympy as sp
 
 from ..params import Body
-from ..rotation_equations import (corrected_p0, derive_eight_equation, derive_rotation_equation, printed_eq33,
-                                  printed_eq37, printed_p0)
+from ..rotation.equations import (corrected_p0, derive_eight_equation, derive_rotation_equation,
+                                  printed_eq33, printed_eq37, printed_p0)
 from ..trajectories import PAPER_HEADING_SERIES, eight_heading_fourier
 from .verdicts import Erratum, Verdict
 
@@ -24,7 +24,7 @@ def _table_values():
 
 def _check_eq33(printed=None, corrected=None):
     """(33): ``printed`` and ``corrected`` are the right side of v_p' (defaults
-    :func:`lib.rotation_equations.printed_eq33` and the same with the sign of its
+    :func:`lib.rotation.equations.printed_eq33` and the same with the sign of its
     cos p term flipped); each holds if it equals the derivation."""
     eq = derive_rotation_equation()
     s = eq.params
@@ -39,7 +39,7 @@ def _check_eq33(printed=None, corrected=None):
 
 def _check_p0(printed=None, corrected=None):
     """The equilibria of (33): ``printed`` and ``corrected`` are functions k -> p0^(k)
-    (defaults :func:`lib.rotation_equations.printed_p0`, ``corrected_p0``); each holds
+    (defaults :func:`lib.rotation.equations.printed_p0`, ``corrected_p0``); each holds
     if the derived (33) at rest vanishes there for k = 0, 1 (the corrected one
     symbolically too)."""
     printed = printed_p0 if printed is None else printed
@@ -58,7 +58,7 @@ def _check_p0(printed=None, corrected=None):
 
 def _check_eq37(printed=None, corrected=None):
     """(37): ``printed`` and ``corrected`` are its right side (defaults
-    :func:`lib.rotation_equations.printed_eq37` with the bracket as printed and as
+    :func:`lib.rotation.equations.printed_eq37` with the bracket as printed and as
     corrected); each holds if it equals the derivation."""
     _, torque, _ = derive_eight_equation()
     printed = printed_eq37(True) if printed is None else printed

@@ -1,0 +1,334 @@
+"""The force and angle limits of paper Sec. 5 (Chapter 4): the long-run regime of the
+closed loop under an angle limit (and a force cap), decided from a stroboscopic
+section, located periodic orbits with their Floquet multipliers, and the largest
+Lyapunov exponent, for one pair of limits or many at once.
+
+Two integrators run the switched closed loop: the adaptive, event-located
+:class:`lib.integrators.switched.SwitchedLoop` (the reference, one run at a time:
+:mod:`lib.limits.sections`, whose names are re-exported here)
+and the compiled fixed-step one (:mod:`lib.integrators.switched_compiled`, many
+runs at once, about a hundred times faster: :func:`lib.limits.runs.switched_runs`,
+re-exported here, and :func:`limit_verdicts`, which Chapter 4 uses). The verdict tools are generic
+(:mod:`lib.dynamics`) and re-exported here.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from ..machinery import checks
+from ..angles import state_difference
+from ..dynamics import verdicts as dv
+from ..dynamics.lyapunov import LyapunovEstimate, largest_lyapunov
+from ..dynamics.sections import distinct_points, section_margin, section_period
+from ..integrators.switched import Segments, SwitchedLoop
+from ..machinery.parallel import map_chunks
+from .sections import Regime, classify, section_sweep, stroboscopic_section, sweep_angle_limit  # re-exported
+from ..params import Body, Gains
+from ..dynamics.sampled import sampled_extremes, sampled_range
+from .runs import (STEPS_PER_PERIOD, SwitchedRuns, _check_parts, _concat_runs, _limits_arrays, _start_states,
+                   error_state, switched_runs)
+from ..trajectories import Reference
+
+__all__ = [
+    "error_state", "stroboscopic_section", "Regime", "classify", "section_sweep", "sweep_angle_limit",
+    "SwitchedRuns", "switched_runs", "limit_verdicts", "extend_undecided", "UNDECIDED_FACTOR", "regime_edges", "LIMIT_DEFAULTS", "STEPS_PER_PERIOD",
+    # re-exported from where they are defined
+    "SwitchedLoop", "Segments", "largest_lyapunov", "LyapunovEstimate", "distinct_points", "section_period",
+    "section_margin", "state_difference",
+]
+
+
+# ---------------------------------------------------------------- the compiled runs and their verdicts
+
+
+#: the options of :func:`limit_verdicts`; the thresholds mean what they mean in :mod:`lib.dynamics.verdicts`
+LIMIT_DEFAULTS = dict(transient=60, periods=120, block=12, max_period=8, candidate_tol=1e-3, newton_tol=1e-9,
+                      fd_step=1e-6, reach_tol=1e-3, approach_tol=0.05, lyapunov_band=0.01, return_tol=0.05,
+                      slip_band=1e-3)
+
+#: Newton on the switched loop's period map: the Jacobian by differences, steps cut to 0.1
+_NEWTON = dict(max_iter=9, max_step=0.1)
+
+_STATUS = {"not converged": "Newton did not converge", "not attracting": "the orbit found is not attracting",
+           "not reached": "the run has not reached the orbit"}
+
+
+class _SwitchedMap:
+    """The switched loop's period map (a :class:`lib.dynamics.verdicts.PeriodMap`) over runs
+    with their own limits: the state (x, y, phi, and rates), the heading phi in column 2."""
+
+    turn_axis = 2
+
+    def __init__(self, body, gains, ref, b, f, steps_per_period):
+        self.body, self.gains, self.ref, self.b, self.f, self.steps = body, gains, ref, b, f, steps_per_period
+
+    def advance(self, idx, x, k):
+        k = np.unique(np.asarray(k, dtype=int))
+        if k.size != 1:
+            raise ValueError("the switched runs of one call share their number of periods")
+        return switched_runs(self.body, self.gains, self.ref, self.b[idx], self.f[idx], s0=x, n_periods=int(k[0]),
+                             steps_per_period=self.steps).states[:, -1]
+
+    def step(self, idx, x, k, h):
+        return dv.difference_jacobian(self, idx, x, k, h)
+
+
+def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force_limits=None, *, s0=None,
+                   steps_per_period: int = STEPS_PER_PERIOD, executor=None, chunk_size: int | None = None,
+                   progress: bool | None = None, **options):
+    """Decide the long-run regime of the switched closed loop for each (angle limit (rad),
+    force limit (N)) pair by the book's one decision procedure (:mod:`lib.dynamics.verdicts`)
+    on the full state. Options (:data:`LIMIT_DEFAULTS`): ``transient`` periods dropped,
+    then ``periods`` periods of section and of Lyapunov renormalisation.
+
+    - **periodic** (or **slipping** if the heading advances by whole turns every k
+      periods): the section repeats at a lag k <= ``max_period`` to ``candidate_tol``
+      over its last 2 ``max_period`` states; Newton on P^k(x) = x + (0, 0, 2 pi n, 0, 0, 0),
+      with the Jacobian by forward differences (step ``fd_step``), converges to
+      ``newton_tol``; the orbit attracts (all Floquet multipliers, the eigenvalues of
+      DP^k, inside the unit circle) and the run has reached it
+      (:func:`lib.dynamics.verdicts.reached`: within ``reach_tol``, or within
+      ``approach_tol`` and closing in no slower than the slowest multiplier allows).
+    - **chaotic**, **quasiperiodic**, **undecided**: the rule
+      :func:`lib.dynamics.verdicts.classify` on the largest Lyapunov exponent lambda (1/s)
+      with its standard error SE from the means of blocks of ``block`` periods; a
+      quasi-periodic section must also enclose no *attracting* period-1 orbit
+      (:func:`lib.dynamics.verdicts.enclosed_orbit`; column floquet then holds the largest
+      |multiplier| of the orbit inside, above 1, where a torus is born from an orbit that
+      lost stability). An attracting one inside means a slow spiral onto it: undecided.
+
+    Columns: angle_limit (rad), angle_deg, force_limit (N, inf for none), regime, period,
+    turns (of the heading per k periods of a slipping orbit), floquet (largest |multiplier|),
+    lyapunov and lyapunov_stderr (1/s), returns; p_range (rad) and pos_err (m, largest
+    position error) over the whole orbit, or over the observed run without one, sampled
+    :data:`MEASURE_SAMPLES` times a period; drift and drift_stderr (turns of the heading per
+    period: n / k on an orbit, else measured with its batch-means error); lost (the heading
+    slips, :func:`lib.dynamics.verdicts.heading_lost`) and turns_round (p_range > 2 pi);
+    crossings, slides, t_sliding (s), reason, and orbit (the located orbit's state at t = 0,
+    [x, y, phi, xdot, ydot, phidot], or None).
+
+    Scale-out: with an ``executor`` (any :class:`concurrent.futures.Executor`) the pairs go to
+    it in consecutive chunks of ``chunk_size`` (default: two chunks per worker; without an
+    executor, ``chunk_size`` runs the chunks here one after another), by
+    :func:`lib.machinery.parallel.map_chunks`; each run is decided on its own, so the frame is the one
+    of the single call, and the runs' arrays are concatenated in order into one
+    :class:`SwitchedRuns`.
+    ``progress``: a bar over the pairs on stderr (:func:`lib.machinery.parallel.show_progress`; default None: only when run
+    interactively, never under pytest or in the book build).
+
+    Parameters
+    ----------
+    body : Body
+        The plant and the controller's model.
+    gains : Gains
+        The gains of (23).
+    ref : Circle or Eight
+        The reference (:mod:`lib.trajectories`).
+    angle_limits : float or array_like
+        beta_max (rad), in (0, pi], one or one per pair.
+    force_limits : float or array_like, optional
+        F_max (N), > 0 (inf or None for none), one or one per pair.
+    s0 : array_like, optional
+        Start [x, y, phi, xdot, ydot, phidot] (m, rad, m/s, rad/s), (6,) or (N, 6);
+        default the paper's Table.
+    steps_per_period : int
+        Fixed steps per reference period of the compiled integrator (>= 16).
+    executor : concurrent.futures.Executor, optional
+        Where the chunks of pairs run (a process pool, a dask ``Client.get_executor()``).
+    chunk_size : int, optional
+        Points per chunk (default: two chunks per worker with an executor, else all).
+    progress : bool, optional
+        A progress bar on stderr (default None: only when run interactively).
+    **options
+        The procedure's options, :data:`LIMIT_DEFAULTS`.
+
+    Returns
+    -------
+    frame : pandas.DataFrame
+        One row per pair, the columns above.
+    runs : SwitchedRuns
+        The runs behind it, in the order of the pairs.
+    """
+    unknown = set(options) - set(LIMIT_DEFAULTS)
+    if unknown:
+        raise TypeError(f"unknown options {sorted(unknown)}; known: {sorted(LIMIT_DEFAULTS)}")
+    o = {**LIMIT_DEFAULTS, **options}
+    for name, v in o.items():
+        minimum = {"transient": 0, "periods": 2, "block": 2, "max_period": 1}.get(name)
+        o[name] = checks.number(name, v, positive=True) if minimum is None else checks.integer(name, v, minimum=minimum)
+    npr, blk, kmax = o["periods"], o["block"], o["max_period"]
+    if npr < 2 * blk or npr < 2 * kmax + 2:
+        raise ValueError(f"periods ({npr}) must cover two blocks ({blk}) and twice max_period ({kmax})")
+    _check_parts(body, gains, ref)
+    steps_per_period = checks.integer("steps_per_period", steps_per_period, minimum=16)
+    b, f = _limits_arrays(angle_limits, force_limits)
+    S0 = _start_states(s0, b.size)
+    parts = map_chunks(_limit_chunk, b.size, (b, f, S0), dict(body=body, gains=gains, ref=ref, o=o,
+                                                             steps_per_period=steps_per_period),
+                       executor, chunk_size, progress)
+    if len(parts) == 1:
+        return parts[0]
+    return pd.concat([p[0] for p in parts], ignore_index=True), _concat_runs([p[1] for p in parts])
+
+
+def _limit_chunk(b, f, S0, *, body, gains, ref, o, steps_per_period):
+    """(frame, runs) of :func:`limit_verdicts` for validated pairs (one chunk of them)."""
+    ntr, npr, blk, kmax = o["transient"], o["periods"], o["block"], o["max_period"]
+    runs = switched_runs(body, gains, ref, b, f, s0=S0, n_periods=ntr + npr,
+                         lyapunov_from=ntr, steps_per_period=steps_per_period)
+    T, N = runs.period, runs.states.shape[0]
+    pmap = _SwitchedMap(body, gains, ref, runs.angle_limit, runs.force_limit, steps_per_period)
+    step = lambda i, x, k: pmap.step(i, x, k, o["fd_step"])  # noqa: E731
+    lamT, seT = dv.block_statistics(runs.log_growth, blk)
+    hist = np.moveaxis(runs.states[:, ntr:], 0, 1).copy()
+    hist[..., 2] = np.mod(hist[..., 2], 2 * np.pi)     # the map commutes with whole turns of phi
+    idx = np.arange(N)
+    orb = dv.find_orbits(step, pmap, idx, hist, max_period=kmax, candidate_tol=o["candidate_tol"],
+                         newton_tol=o["newton_tol"], reach_tol=o["approach_tol"], reach_floor=o["reach_tol"],
+                         newton_options=_NEWTON, fixed_turns=False, ends=2 * kmax)
+    sec = runs.errors[:, ntr:]
+    returns = dv.section_returns(np.moveaxis(sec, 0, 1), angles=(4,))
+    regime, reason = dv.classify(lamT, seT, returns, band=o["lyapunov_band"], return_tol=o["return_tol"],
+                                 max_period=kmax)
+    mu = np.where(orb["status"] != "", orb["floquet"], np.nan)
+    ring = np.flatnonzero(~orb["found"] & (regime == "quasiperiodic"))
+    if ring.size:
+        att, mu[ring] = dv.enclosed_orbit(step, ring, hist[:, ring], turn_axis=2, newton_tol=o["newton_tol"],
+                                          newton_options=_NEWTON)
+        spiral = ring[att]
+        regime[spiral] = "undecided"
+        reason[spiral] = [f"slow spiral onto an attracting orbit inside the curve (|mu| = {m:.4f})" for m in mu[spiral]]
+    tried = ~orb["found"] & (orb["status"] != "") & (regime == "undecided")
+    reason[tried] = [f"{_STATUS[s]}; {r}" for s, r in zip(orb["status"][tried], reason[tried])]
+    found = orb["found"]
+    mu[found] = orb["rho"][found]
+    regime[found] = dv.orbit_regime(orb["n"][found])
+    reason[found] = ""
+    m = _over_the_run(pmap, runs.states[:, ntr], orb, npr, blk)
+    lost = dv.heading_lost(found, orb["n"], m["drift"], m["drift_stderr"], slip_band=o["slip_band"])
+    frame = pd.DataFrame(dict(
+        angle_limit=runs.angle_limit, angle_deg=np.degrees(runs.angle_limit), force_limit=runs.force_limit,
+        regime=regime, period=orb["k"], turns=orb["n"], floquet=mu, lyapunov=lamT / T, lyapunov_stderr=seT / T,
+        returns=returns, p_range=m["p_range"], pos_err=m["pos_err"], drift=m["drift"],
+        drift_stderr=m["drift_stderr"], lost=lost, turns_round=dv.turns_round(m["p_range"]),
+        crossings=runs.crossings, slides=runs.slides, t_sliding=runs.t_sliding, reason=reason,
+        orbit=[orb["x"][q].copy() if found[q] else None for q in range(N)]))
+    return frame, runs
+
+
+#: samples per reference period of the runs that measure ranges over a whole orbit or run
+MEASURE_SAMPLES = 40
+
+
+def _over_the_run(pmap: "_SwitchedMap", start, orb: dict, periods: int, block: int) -> dict:
+    """What the section alone cannot show, sampled ``MEASURE_SAMPLES`` times a period: the
+    range of p (rad) and the largest position error (m) over the whole orbit (its k periods
+    from the orbit's point) or, without one, over the observed run (``periods`` periods from
+    ``start``, the state at the end of the transient); and the heading's drift (turns per
+    period) with its batch-means standard error (blocks of ``block`` periods): n / k with no
+    error on an orbit. The runs without an orbit are integrated again from ``start`` on the
+    same step grid; for a chaotic one the samples are a second trajectory on the same attractor."""
+    N = start.shape[0]
+    out = dict(p_range=np.full(N, np.nan), pos_err=np.full(N, np.nan), drift=np.full(N, np.nan),
+               drift_stderr=np.full(N, np.nan))
+    groups = [(np.flatnonzero(~orb["found"]), periods, start)]
+    groups += [(np.flatnonzero(orb["found"] & (orb["lag"] == k)), int(k), orb["x"])
+               for k in np.unique(orb["lag"][orb["found"]])]
+    S = MEASURE_SAMPLES
+    for rows, k, x0 in groups:
+        if rows.size == 0:
+            continue
+        r = switched_runs(pmap.body, pmap.gains, pmap.ref, pmap.b[rows], pmap.f[rows], s0=x0[rows], n_periods=k,
+                          steps_per_period=pmap.steps, samples_per_period=S)
+        p = r.states[:, :, 2] - pmap.ref.z(r.t)[:, 2][None]
+        err = r.errors
+        e = np.hypot(err[..., 0], err[..., 1])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            de = np.where(e > 0, (err[..., 0] * err[..., 2] + err[..., 1] * err[..., 3]) / e, 0.0)
+        h = r.t[1] - r.t[0]
+        out["p_range"][rows] = sampled_range(p, cyclic=False, dy=err[..., 5], h=h)     # Hermite-refined extremes
+        out["pos_err"][rows] = sampled_extremes(e, cyclic=False, dy=de, h=h)[1]
+        if k == periods and not orb["found"][rows[0]]:
+            nb = periods // block
+            ends = p[:, ::S * block][:, :nb + 1]
+            out["drift"][rows], out["drift_stderr"][rows] = dv.drift_statistics(ends, block, 2 * np.pi)
+        else:
+            out["drift"][rows], out["drift_stderr"][rows] = orb["n"][rows] / orb["k"][rows], 0.0
+    return out
+
+
+#: how many times longer :func:`extend_undecided` runs the points left undecided
+UNDECIDED_FACTOR = 8
+
+
+def extend_undecided(body: Body, gains: Gains, ref: Reference, frame: pd.DataFrame,
+                     factor: int = UNDECIDED_FACTOR, *,
+                     s0=None, steps_per_period: int = STEPS_PER_PERIOD, **options) -> pd.DataFrame:
+    """Decide the undecided rows of ``frame`` (:func:`limit_verdicts`) again over a horizon
+    ``factor`` times longer (the section and the Lyapunov run, and the blocks of the
+    standard error with them; the same transient and start). On an invariant torus the
+    log-growth of a separation is bounded, so its mean falls as 1 / horizon, and with
+    blocks ``factor`` times longer so does its standard error: a longer horizon resolves a
+    zero exponent where a chaotic one stays positive. Returns a copy of ``frame`` with
+    those rows replaced and a column ``horizon`` (periods of section and Lyapunov run).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of (23).
+    ref : Circle or Eight
+        The reference.
+    frame : pandas.DataFrame
+        A frame of :func:`limit_verdicts`.
+    factor : int
+        Horizon factor.
+    s0 : array_like, optional
+        The start of the frame's runs.
+    steps_per_period : int
+        Fixed steps per period.
+    **options
+        The options of :func:`limit_verdicts`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The frame, its undecided rows decided again, with a column ``horizon``.
+    """
+    o = {**LIMIT_DEFAULTS, **options}
+
+    def redo(rows, k):
+        long = {**o, "periods": o["periods"] * k, "block": o["block"] * k}
+        return limit_verdicts(body, gains, ref, frame.angle_limit.to_numpy()[rows], frame.force_limit.to_numpy()[rows],
+                              s0=s0, steps_per_period=steps_per_period, **long)[0]
+
+    return dv.redecide_undecided(frame, o["periods"], factor, redo)
+
+
+def regime_edges(frame: pd.DataFrame, regime: str = "chaotic") -> pd.DataFrame:
+    """Where a sweep over the angle limit enters or leaves ``regime``: for each force limit
+    of ``frame`` (:func:`limit_verdicts`), the pairs of neighbouring angle limits (rad)
+    with ``regime`` on one side only. Columns force_limit, lo, hi, below, above (the
+    regimes at lo and at hi).
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        A frame of :func:`limit_verdicts`.
+    regime : str
+        The regime.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns force_limit (N), lo, hi (rad), below, above.
+    """
+    rows = []
+    for cap, g in frame.sort_values("angle_limit").groupby("force_limit", sort=True):
+        a, r = g.angle_limit.to_numpy(), g.regime.to_numpy()
+        for i in np.flatnonzero((r[:-1] == regime) != (r[1:] == regime)):
+            rows.append(dict(force_limit=cap, lo=a[i], hi=a[i + 1], below=r[i], above=r[i + 1]))
+    return pd.DataFrame(rows, columns=["force_limit", "lo", "hi", "below", "above"])
