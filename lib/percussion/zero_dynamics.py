@@ -37,7 +37,7 @@ from ..params import Body
 from ..trajectories import POSITIONS, Reference, _Path
 from .point import centre_of_percussion, lateral_drag_speed
 
-__all__ = ["path_drive", "heading_rate", "frozen_lock", "CircleSteadyMotion", "circle_steady_motion",
+__all__ = ["path_drive", "heading_rate", "frozen_lock", "CircleSteadyMotion", "circle_steady_motion", "circle_slip",
            "circle_lock_radius", "zero_dynamics_run"]
 
 
@@ -231,3 +231,27 @@ def zero_dynamics_run(body: Body, ref: Reference, t, phi0: float, *, rtol: float
 
     sol = solve_ivp(rhs, (0.0, float(t[-1])), [phi0], method="DOP853", t_eval=t, rtol=rtol, atol=atol)
     return sol.y[0]
+
+
+def circle_slip(body: Body, R: float, Theta: float) -> float:
+    """Below the lock radius, the heading error's mean drift on the circle (turns of p per
+    period, negative: it falls behind): -sqrt(1 - (R / R_lock)^2), from the autonomous equation
+    delta' = -(|w| / eps) sin delta - Theta of the lag behind w; 0 at and above the lock radius.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    R : float
+        Radius of P's circle (m), > 0.
+    Theta : float
+        Rate (rad/s), > 0.
+
+    Returns
+    -------
+    float
+        Turns per period.
+    """
+    R = checks.number("R", R, positive=True, unit="m")
+    ratio = R / circle_lock_radius(body, Theta)
+    return -math.sqrt(1 - ratio**2) if ratio < 1 else 0.0
