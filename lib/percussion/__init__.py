@@ -14,7 +14,8 @@ from .derivation import PointDerivation, derive_point
 from .law import DEFAULT_POLE, applied_force, error_polynomial, law_inputs
 from .point import (body_state_from_point, centre_of_percussion, drag_mismatch, lateral_drag_speed, point_accel,
                     point_state)
-from .run import PercussionResult, point_error, simulate
+from .figures import plot_percussion_map, plot_steady_pair
+from .run import PercussionResult, designed_error_deviation, point_error, simulate
 from .compare import SteadyMotion, paper_steady, path_distance, percussion_steady, steady_table
 from .sweep import SWEEP_DEFAULTS, percussion_fig5_map, rotation_sweep
 from .zero_dynamics import (CircleSteadyMotion, circle_lock_radius, circle_slip, circle_steady_motion, frozen_lock, heading_rate,
@@ -22,7 +23,8 @@ from .zero_dynamics import (CircleSteadyMotion, circle_lock_radius, circle_slip,
 
 __all__ = ["PointDerivation", "derive_point", "DEFAULT_POLE", "applied_force", "error_polynomial", "law_inputs",
            "body_state_from_point", "centre_of_percussion", "drag_mismatch", "lateral_drag_speed", "point_accel",
-           "point_state", "PercussionResult", "point_error", "simulate", "CircleSteadyMotion", "circle_lock_radius",
+           "point_state", "PercussionResult", "point_error", "simulate", "designed_error_deviation",
+           "plot_percussion_map", "plot_steady_pair", "CircleSteadyMotion", "circle_lock_radius",
            "circle_steady_motion", "circle_slip", "frozen_lock", "heading_rate", "path_drive", "zero_dynamics_run",
            "SteadyMotion", "paper_steady", "path_distance", "percussion_steady", "steady_table", "SWEEP_DEFAULTS",
            "percussion_fig5_map", "rotation_sweep"]

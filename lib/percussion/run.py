@@ -16,7 +16,7 @@ from ..trajectories import Reference, position_kinematics
 from .law import DEFAULT_POLE, closed_loop_rates, error_polynomial
 from .point import point_accel, point_state
 
-__all__ = ["PercussionResult", "simulate", "point_error", "reference_point_kinematics"]
+__all__ = ["PercussionResult", "simulate", "point_error", "reference_point_kinematics", "designed_error_deviation"]
 
 _NAMES = ("x", "y", "phi", "xdot", "ydot", "phidot", "thrust")
 
@@ -129,3 +129,36 @@ def point_error(body: Body, res: SimulationResult) -> tuple[np.ndarray, np.ndarr
     if thrust is not None:
         dde = ddPd - point_accel(body, res.z[:, 2], res.dz[:, 2], dP, thrust)
     return Pd - P, dPd - dP, dde
+
+
+def designed_error_deviation(body: Body, gains: Gains, res: PercussionResult, pole: float = DEFAULT_POLE) -> float:
+    """The largest distance (m) between P's error in the run ``res`` and the solution of the
+    designed equation e''' + k2 e'' + k1 e' + k0 e = 0 from the run's start (matrix exponential).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    gains : Gains
+        The gains of the run.
+    res : PercussionResult
+        A run of :func:`simulate` with ``pole``.
+    pole : float
+        The extra pole (1/s).
+
+    Returns
+    -------
+    float
+        max over samples and axes of |e - e_designed| (m).
+    """
+    from scipy.linalg import expm
+
+    e, de, dde = point_error(body, res)
+    k = error_polynomial(body, gains, pole)
+    worst = 0.0
+    for j in range(2):
+        A = np.array([[0, 1, 0], [0, 0, 1], [-k[j, 2], -k[j, 1], -k[j, 0]]])
+        x0 = np.array([e[0, j], de[0, j], dde[0, j]])
+        want = np.array([(expm(A * t) @ x0)[0] for t in res.t - res.t[0]])
+        worst = max(worst, float(np.abs(e[:, j] - want).max()))
+    return worst
