@@ -1,3 +1,3 @@
 """The book's figures: the tracking runs and the body (:mod:`.tracking`, Chapters 1 and 3),
-the maps and sweeps of Chapters 4-6 (:mod:`.maps`), and the animations (:mod:`.animation`).
+the maps and sweeps of Chapters 4-6 (:mod:`.maps`), Chapter 7's (:mod:`.percussion`), and the animations (:mod:`.animation`).
 Each helper takes an optional ``ax`` and returns the figure."""

@@ -15,10 +15,12 @@ import math
 import numpy as np
 
 from ..machinery.cache import cached
+from ..rotation.circle import circle_critical_radius, circle_equilibria
 from ..rotation.circle_global import bistable_window, torque_pendulum_threshold, window_closing_rate
 from ..limits.attractors import (heading_offset_starts, lyapunov_horizons, mirror_defect, mirrored_start,
                                  start_attractors)
 from ..tracking.mismatch import mismatch_study
+from ..percussion import circle_lock_radius, circle_steady_motion, percussion_fig5_map
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from ..rotation.verdicts import fig5_map
 from ..rotation.slow_eight import slow_eight_prediction
@@ -133,6 +135,30 @@ def _check_lyapunov() -> Outcome:
                    "Chapter 4 also shows them independent of the initial separation d0")
 
 
+def _check_percussion_circle() -> Outcome:
+    body = Body()
+    p0 = circle_equilibria(body, R0, THETA0)[0]
+    s = -body.I / (body.m * body.a)
+    R_P = math.sqrt(R0**2 - 2 * R0 * s * math.sin(p0) + s**2)
+    st = circle_steady_motion(body, R_P, THETA0)
+    gap = abs(st.radius_C / R0 - 1.0)
+    ok = gap < 1e-12 and circle_lock_radius(body, THETA0) < circle_critical_radius(body, THETA0) and st.rate < 0
+    return Outcome(decide(ok, "extended"), st.rate,
+                   "the heading's rate (1/s) on the circle with P on the paper's P-circle, Chapter 7",
+                   f"closed form; given the circle P runs under the paper's law, C's closed-form circle is the "
+                   f"paper's R (agreement {gap:.1e}); the lock radius lies below the paper's (36)")
+
+
+def _check_percussion_map() -> Outcome:
+    fr = percussion_fig5_map(Body(), n=100)
+    held = float(((fr.regime == "periodic") & ~fr.lost).mean())
+    ok = held == 1.0 and not (fr.regime == "chaotic").any()     # Chapter 7: every point held
+    return Outcome(decide(ok, "extended"), held,
+                   "share of Fig. 5's 100 x 100 grid where the heading is held under the law for P",
+                   "decided by lib.dynamics.verdicts on the zero dynamics' exact period map (a Moebius map: "
+                   "no chaos)")
+
+
 def items() -> list[Item]:
     """The extension rows, in the order of the chapters."""
     I = Item  # noqa: E741
@@ -149,4 +175,8 @@ def items() -> list[Item]:
           "chapters/05_stability", "extended", _check_slow_eights),
         I("weight-limit", "Sec. 4 open problem, extended: the weighted law on the circle, its exact limit",
           "chapters/06_allocation", "extended", _check_weighted_circle),
+        I("percussion-circle", "Secs. 4-6, extended: tracking the centre of percussion, the circle in closed form",
+          "chapters/07_percussion", "extended", _check_percussion_circle),
+        I("percussion-map", "Sec. 6, extended: Fig. 5 under the law for the centre of percussion",
+          "chapters/07_percussion", "extended", _check_percussion_map),
     ]

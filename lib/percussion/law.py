@@ -1,0 +1,105 @@
+"""A tracking law for the centre of percussion P, and its closed loop.
+
+P'' does not contain the lateral force u2 (:mod:`lib.percussion.derivation`): static feedback
+is singular. With the thrust u1 made a state xi (an integrator, xi' = nu), P''' is affine in
+(nu, u2) through a matrix with determinant -(c/m - c_phi/I_C)/m^2, regular for the book's
+body. Writing P''' from :mod:`lib.percussion.point`,
+
+    P''' = (nu/m) e1 + omega' (-2 s_P omega e1 + eps/s_P * s_P e2) + (xi/m - s_P omega^2) omega e2
+           - k P'' - eps omega^2 e1,
+
+the law asks P''' = D := P_d''' + k2 e'' + k1 e' + k0 e (e = P_d - P), i.e.
+
+    omega' = r . e2 / eps,  nu = m (r . e1 + 2 s_P omega omega'),  u2 = (I_C omega' + c_phi omega) / a,
+    r = D + k P'' - (xi/m - s_P omega^2) omega e2 + eps omega^2 e1,
+
+so that every component of P's error obeys e''' + k2 e'' + k1 e' + k0 e = 0, the polynomial
+(lambda + pole)(lambda^2 + (Kv/m) lambda + Kp/m): the paper's error equation (24) for the
+position times one more real pole (:func:`error_polynomial`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..machinery import checks
+from ..params import Body, Gains
+from .point import centre_of_percussion, lateral_drag_speed, point_accel, point_state
+
+__all__ = ["DEFAULT_POLE", "error_polynomial", "law_inputs", "closed_loop_rates", "applied_force"]
+
+#: the extra real pole (1/s) of the default error polynomial
+DEFAULT_POLE = 2.0
+
+
+def error_polynomial(body: Body, gains: Gains, pole: float = DEFAULT_POLE) -> np.ndarray:
+    """(k2, k1, k0) per axis (2, 3) of e''' + k2 e'' + k1 e' + k0 e = 0: the product of
+    (lambda + pole) with the paper's (24) for the axis, lambda^2 + (Kv/m) lambda + Kp/m.
+
+    Parameters
+    ----------
+    body : Body
+        The body (its m).
+    gains : Gains
+        Kp, Kv (x and y entries).
+    pole : float
+        The extra pole (1/s), > 0.
+
+    Returns
+    -------
+    numpy.ndarray
+        (2, 3): rows x, y; columns k2 (1/s), k1 (1/s^2), k0 (1/s^3).
+    """
+    checks.instance("body", body, Body)
+    checks.instance("gains", gains, Gains)
+    pole = checks.number("pole", pole, positive=True, unit="1/s")
+    b, c = gains.kv[:2] / body.m, gains.kp[:2] / body.m
+    return np.stack([b + pole, c + pole * b, pole * c], -1)
+
+
+def law_inputs(body: Body, coeffs: np.ndarray, ref_kin, z, dz, xi) -> tuple[np.ndarray, np.ndarray]:
+    """The law's inputs (nu (N/s), u2 (N)) at the state (z, dz, xi), vectorised over (...).
+
+    ``ref_kin`` = (P_d, P_d', P_d'', P_d''') each (..., 2); ``coeffs`` from
+    :func:`error_polynomial`. Unvalidated kernel.
+    """
+    s, eps, k, m = centre_of_percussion(body), lateral_drag_speed(body), body.c / body.m, body.m
+    phi, om = z[..., 2], dz[..., 2]
+    P, dP = point_state(body, z, dz)
+    ddP = point_accel(body, phi, om, dP, xi)
+    Pd, dPd, ddPd, dddPd = ref_kin
+    D = dddPd + coeffs[:, 0] * (ddPd - ddP) + coeffs[:, 1] * (dPd - dP) + coeffs[:, 2] * (Pd - P)
+    c, sn = np.cos(phi), np.sin(phi)
+    along = xi / m - s * om**2
+    r1 = (D[..., 0] + k * ddP[..., 0]) * c + (D[..., 1] + k * ddP[..., 1]) * sn + eps * om**2
+    r2 = -(D[..., 0] + k * ddP[..., 0]) * sn + (D[..., 1] + k * ddP[..., 1]) * c - along * om
+    dom = r2 / eps
+    nu = m * (r1 + 2 * s * om * dom)
+    u2 = (body.I * dom + body.c_phi * om) / body.a
+    return nu, u2
+
+
+def applied_force(xi, u2, force_cap=None, angle_cap=None) -> tuple[np.ndarray, np.ndarray]:
+    """(F, beta) of the body-frame force (xi, u2) (N), with F clipped to ``force_cap`` (N) and
+    beta to |beta| <= ``angle_cap`` (rad) when given (the paper's Sec. 5 limits)."""
+    F, beta = np.hypot(xi, u2), np.arctan2(u2, xi)
+    if angle_cap is not None:
+        beta = np.clip(beta, -angle_cap, angle_cap)
+    if force_cap is not None:
+        F = np.minimum(F, force_cap)
+    return F, beta
+
+
+def closed_loop_rates(body: Body, coeffs, ref_kin, y, limits=None):
+    """Rates of the closed loop's state y = (x, y, phi, x', y', phi', xi) (..., 7) under the
+    law, and the applied (F, beta). Unvalidated kernel."""
+    z, dz, xi = y[..., :3], y[..., 3:6], y[..., 6]
+    nu, u2 = law_inputs(body, coeffs, ref_kin, z, dz, xi)
+    fc = None if limits is None else limits.force
+    ac = None if limits is None else limits.angle
+    F, beta = applied_force(xi, u2, fc, ac)
+    phi = z[..., 2]
+    acc = np.stack([(F * np.cos(phi + beta) - body.c * dz[..., 0]) / body.m,
+                    (F * np.sin(phi + beta) - body.c * dz[..., 1]) / body.m,
+                    (F * body.a * np.sin(beta) - body.c_phi * dz[..., 2]) / body.I], -1)
+    return np.concatenate([dz, acc, nu[..., None]], -1), F, beta
