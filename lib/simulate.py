@@ -94,6 +94,28 @@ def _instance(name: str, value, cls):
     return cls() if value is None else checks.instance(name, value, cls)
 
 
+#: explicit methods of :func:`scipy.integrate.solve_ivp` (their step is bounded by stability)
+EXPLICIT_METHODS = ("RK23", "RK45", "DOP853")
+#: the largest Lambda t_end an explicit run is allowed: the closed loop's fastest rate Lambda (1/s)
+#: times the time span; an explicit method needs at least about Lambda t_end / 4 steps (its
+#: stability region reaches about 4 along the negative real axis), so this is about 2.5e6 steps,
+#: minutes of CPU in Python
+MAX_STIFFNESS = 1e7
+
+
+def _check_stiffness(body: Body, gains: Gains, t_end: float, integration) -> None:
+    """Refuse an explicit run that stiffness would make last for hours (a tiny mass or inertia,
+    huge gains), naming the rate and the fix."""
+    if integration.method not in EXPLICIT_METHODS:
+        return
+    M, N = body.mass_matrix.diagonal(), body.drag
+    rate = float(np.max((gains.kv + N) / M + np.sqrt(gains.kp / M)))
+    if rate * t_end > MAX_STIFFNESS:
+        raise ValueError(f"the closed loop's fastest rate, about {rate:.3g} 1/s (from m, I_C, the drag and the gains), "
+                         f"makes {integration.method} over t_end = {t_end:g} s need about {rate * t_end / 4:.2g} steps "
+                         f"(more than {MAX_STIFFNESS / 4:.2g}); use a stiff method, integration=Integration(method='Radau'), or a shorter t_end")
+
+
 def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz0=None, *,
              limits: Limits | None = None, allocation: Allocation | None = None, t_eval=None,
              integration: Integration | None = None, model: Body | None = None) -> SimulationResult:
@@ -166,6 +188,7 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
     integration = _instance("integration", integration, Integration)
     if model is not None:
         checks.instance("model", model, Body, "lib.params.Body or None")
+    _check_stiffness(body, gains, t_end, integration)
     if t_eval is None:
         t_eval = np.linspace(0.0, t_end, int(round(t_end * DEFAULT_RATE)) + 1)
     t_eval = checks.array("t_eval", t_eval)

@@ -337,7 +337,7 @@ def make(name: str, R: float, theta: float) -> Reference:
     try:
         factory = NAMES[name]
     except (KeyError, TypeError):
-        raise ValueError(f"unknown trajectory {name!r}; known: {sorted(NAMES)}") from None
+        raise ValueError(f"name must be one of {sorted(NAMES)} (the trajectory), got {name!r}") from None
     return factory(R, theta)
 
 

@@ -54,7 +54,7 @@ def test_steady_metrics_need_enough_periods():
 
 
 @pytest.mark.parametrize("kw,exc,msg", [
-    ({"kind": "square"}, ValueError, "unknown trajectory 'square'"),
+    ({"kind": "square"}, ValueError, r"^kind must be one of .*got 'square'"),
     ({"R": []}, ValueError, "empty"),
     ({"R": [1.0, -1.0]}, ValueError, r"R\[1\] must be positive"),
     ({"Theta": [0.0]}, ValueError, "non-zero"),

@@ -101,7 +101,7 @@ def test_lean_field_is_the_closed_loop_of_eqs_23_and_2_4():
 
 
 @pytest.mark.parametrize("kw,exc,msg", [
-    ({"kind": "square"}, ValueError, "unknown trajectory 'square'"),
+    ({"kind": "square"}, ValueError, r"^kind must be one of .*got 'square'"),
     ({"kind": ["eight", "circle", "eight"]}, ValueError, "3 entries for 1 points"),
     ({"R": [-1.0]}, ValueError, r"R\[0\] must be positive"),
     ({"weights": (0.0, 0.0, 0.0)}, ValueError, "not all zero"),

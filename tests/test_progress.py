@@ -70,3 +70,16 @@ def test_a_sweep_with_progress_is_the_same_frame(capsys):
     shown = eight_rotation_sweep(Body(), R, Th, max_periods=24, progress=True)
     assert "3/3" in capsys.readouterr().err
     pd.testing.assert_frame_equal(shown, quiet, check_exact=True)
+
+
+def test_the_bar_is_labelled_with_the_sweep_the_user_called(monkeypatch):
+    import lib.machinery.parallel as P
+    labels = []
+    real = P._bar
+    monkeypatch.setattr(P, "_bar", lambda total, desc: labels.append(desc) or real(total, desc))
+
+    def my_sweep():
+        return P.map_chunks(lambda a: pd.DataFrame({"x": a}), 4, (np.arange(4.0),), progress=True)
+
+    my_sweep()
+    assert labels == ["my_sweep"]

@@ -6,6 +6,7 @@ allocation with a zero weight (w_x w_y = 0) runs instead of failing the batch's 
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 import sympy as sp
 
@@ -232,3 +233,52 @@ def test_a_closed_loop_run_that_diverges_is_decided_so_with_no_steady_measures()
     row = f.iloc[0]
     assert row.regime == "undecided" and "non-finite" in row.reason and row.lost and row.position_lost
     assert np.all(np.isnan(f[["p_range", "p_rms", "pos_rms", "pos_max"]]))
+
+
+# ---------------------------------------------------------------- inputs outside the methods' range (issue 27)
+
+
+@pytest.mark.parametrize("kw", [{"m": 1e-300}, {"I": 1e9}, {"c_phi": 1e-7}])
+def test_a_body_far_outside_the_methods_range_is_refused_naming_the_range(kw):
+    name = next(iter(kw))
+    with pytest.raises(ValueError, match=rf"^Body\.{name} must lie in \[1e-06, 1e\+06\]"):
+        Body(**kw)
+    Body(**{name: 1e-6}), Body(**{name: 1e6})       # the ends are inside
+
+
+def test_an_explicit_run_that_stiffness_would_make_endless_is_refused_naming_the_fix():
+    with pytest.raises(ValueError, match=r"fastest rate, about 3\.8\de\+06 1/s.*method='Radau'"):
+        simulate(Body(m=1e-6), GAINS, T.circle(), 60.0)
+    # the rate is the closed loop's: (kv + c) / m + sqrt(kp / m) on x, here 3.83e6 1/s
+
+
+@pytest.mark.parametrize("R, Theta, msg", [(1e9, 1.0, r"^R\[0\] = 1e\+09 m .* outside the verdicts' domain"),
+                                           (2.0, 1e9, r"^Theta\[0\] = 1e\+09 rad/s is outside the verdicts' domain "
+                                                      r"Theta <= 50\.27")])
+def test_a_fig5_point_outside_the_verdicts_domain_is_refused_at_once(R, Theta, msg):
+    with pytest.raises(ValueError, match=msg):
+        stability.eight_rotation_sweep(BODY, [R, 1.0], [Theta, 1.0])
+    # the map's own corner is inside: 2 pi 8 c_phi / I_C = 50.27 rad/s for the Table's body
+
+
+def test_sweeps_broadcast_one_radius_or_one_rate_alike():
+    a = stability.eight_rotation_sweep(BODY, [2.0], [0.5, 1.0])
+    b = stability.eight_rotation_sweep(BODY, [2.0, 2.0], [0.5, 1.0])
+    pd.testing.assert_frame_equal(a, b)
+    with pytest.raises(ValueError, match=r"equal lengths \(or length 1\), got 2 and 3"):
+        stability.eight_rotation_sweep(BODY, [1.0, 2.0], [0.5, 1.0, 1.5])
+
+
+def test_weights_of_the_wrong_length_are_named():
+    with pytest.raises(ValueError, match=r"^weights must be \(w_x, w_y, w_phi\).*got shape \(2,\)"):
+        loop_verdicts.closed_loop_verdicts(BODY, GAINS, "eight", [2.0], [0.5], weights=(1.0, 1.0))
+    with pytest.raises(ValueError, match=r"^Theta\[1\] must be non-zero"):
+        loop_verdicts.closed_loop_verdicts(BODY, GAINS, "eight", [2.0, 2.0], [0.5, 0.0])
+
+
+def test_a_regime_compares_equal_to_its_copy_section_and_nan_included():
+    from dataclasses import replace
+
+    from lib.limits.sections import Regime
+    r = Regime(0.5, np.array([[1.0, np.nan]]), 1, False, np.nan, 0.1, "periodic", 3, 0.2)
+    assert r == replace(r) and r != replace(r, section=np.array([[1.0, 2.0]])) and r != replace(r, period=2)

@@ -58,7 +58,7 @@ def stroboscopic_section(loop: SwitchedLoop, s0, n_transient: int, n_points: int
     return error_state(loop.ref, seg.t, seg.y)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Regime:
     """Long-run behaviour at one angle limit: the stroboscopic section, its period
     (:func:`section_period`; 0 means none up to 8) and whether it was still
@@ -74,6 +74,18 @@ class Regime:
     verdict: str
     n_crossings: int
     t_sliding: float
+
+    def __eq__(self, other: object) -> bool:
+        """Field by field; the section compared as an array, a NaN equal to a NaN."""
+        if not isinstance(other, Regime):
+            return NotImplemented
+        def same(a, b) -> bool:
+            if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+                return np.array_equal(a, b, equal_nan=True)
+            return a == b or (isinstance(a, float) and isinstance(b, float) and np.isnan(a) and np.isnan(b))
+        return all(same(getattr(self, f), getattr(other, f)) for f in self.__dataclass_fields__)
+
+    __hash__ = None
 
 
 def classify(period: int, lyapunov: float, stderr: float, *, zero_band: float = 0.01) -> str:

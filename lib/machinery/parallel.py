@@ -65,6 +65,12 @@ def show_progress(progress: bool | None = None) -> bool:
         return False
 
 
+def _caller() -> str:
+    """The name of the function that asked for the work (the sweep a user called, e.g.
+    ``rotation_verdicts``), the progress bar's label."""
+    return sys._getframe(2).f_code.co_name
+
+
 def _bar(total: int, desc: str | None):
     """A tqdm bar over ``total`` points on stderr (tqdm imported only when a bar is shown)."""
     from tqdm.auto import tqdm
@@ -160,7 +166,7 @@ def map_in_processes(fn: Callable, items: Sequence, workers: int, progress: bool
             return [fn(x) for x in items]
         with process_pool(min(workers, len(items))) as ex:
             return list(ex.map(fn, items))
-    with _bar(len(items), getattr(fn, "__name__", None)) as bar:
+    with _bar(len(items), _caller()) as bar:
         if workers == 1 or len(items) <= 1:
             out = []
             for x in items:
@@ -271,7 +277,7 @@ def map_chunks(fn: Callable, n: int, arrays: Sequence, kwargs: dict | None = Non
     for a in arrays:
         if a is not None and len(a) != n:
             raise ValueError(f"every array must have the n = {n} points on its first axis, got {len(a)}")
-    bar = _bar(n, getattr(fn, "__name__", "").strip("_") or None) if show_progress(progress) else None
+    bar = _bar(n, _caller()) if show_progress(progress) else None
     if chunk_size is None:
         if executor is not None:
             chunk_size = math.ceil(n / (2 * executor_workers(executor)))

@@ -50,7 +50,35 @@ def paper_steady(body: Body, kind: str, R: float, Theta: float, *, transient: in
                  record_steps: int = 512) -> SteadyMotion:
     """The paper's law (23), (25)-(26) with C on the path: one period of its attracting orbit
     (the start on the reference, ``transient`` periods, then Newton, on the map of ``steps``
-    steps per period), recorded at ``record_steps`` steps."""
+    steps per period), recorded at ``record_steps`` steps.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    kind : str
+        ``"eight"`` (28) or ``"circle"`` (27).
+    R : float
+        Size of the path (m), > 0.
+    Theta : float
+        Rate of the reference (rad/s), > 0.
+    transient : int
+        Periods run from the start on the reference before Newton.
+    steps : int
+        Steps per period of the period map the orbit is found on.
+    record_steps : int
+        Steps of the recorded period.
+
+    Returns
+    -------
+    SteadyMotion
+        ``record_steps + 1`` samples from t = 0 to the period 2 pi / Theta (s); C on the path.
+
+    Raises
+    ------
+    ValueError
+        If no orbit of period 1 of the reduced rotation is found.
+    """
     R, Theta = _check(body, kind, R, Theta)
     ref = make(kind, R, Theta)
     orb = rotation_orbit(body, kind, [R], [Theta], transient=transient, steps=steps)
@@ -69,7 +97,32 @@ def paper_steady(body: Body, kind: str, R: float, Theta: float, *, transient: in
 
 def percussion_steady(body: Body, kind: str, R: float, Theta: float, *, steps: int = 512) -> SteadyMotion:
     """The law for P with P on the path: one period of the zero dynamics' attracting orbit
-    (decided by :func:`lib.percussion.rotation_sweep`), the force and C along it."""
+    (decided by :func:`lib.percussion.rotation_sweep`), the force and C along it.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    kind : str
+        ``"eight"`` (28) or ``"circle"`` (27), the path of P.
+    R : float
+        Size of the path (m), > 0.
+    Theta : float
+        Rate of the reference (rad/s), > 0.
+    steps : int
+        Magnus steps per period, of the verdict and of the record.
+
+    Returns
+    -------
+    SteadyMotion
+        ``steps`` samples at the step ends, t from (2 pi / Theta) / ``steps`` to 2 pi / Theta (s);
+        P on the path, C = P - s_P e1 off it.
+
+    Raises
+    ------
+    ValueError
+        If the heading is not held on an orbit of period 1.
+    """
     R, Theta = _check(body, kind, R, Theta)
     v = rotation_sweep(body, [R], [Theta], kind=kind, steps=steps)
     if v.regime[0] != "periodic" or v.period[0] != 1:
@@ -96,7 +149,24 @@ def percussion_steady(body: Body, kind: str, R: float, Theta: float, *, steps: i
 
 def path_distance(kind: str, R: float, points, n: int = 20000) -> np.ndarray:
     """Distance (m) of ``points`` (M, 2) from the path ``kind`` of size R, to the nearest of n
-    samples of the path refined by a parabola (error far below 1e-6 m for n = 20000)."""
+    samples of the path refined by a parabola (error far below 1e-6 m for n = 20000).
+
+    Parameters
+    ----------
+    kind : str
+        ``"eight"`` (28) or ``"circle"`` (27).
+    R : float
+        Size of the path (m).
+    points : array_like
+        Points (M, 2) (m).
+    n : int
+        Samples of the path over one period.
+
+    Returns
+    -------
+    numpy.ndarray
+        (M,): the distances (m).
+    """
     s = np.linspace(0, 2 * np.pi, n, endpoint=False)
     curve = make(kind, R, 1.0).z(s)[:, :2]
     pts = np.asarray(points, float)
@@ -112,7 +182,23 @@ def path_distance(kind: str, R: float, points, n: int = 20000) -> np.ndarray:
 
 def steady_table(body: Body, cases) -> pd.DataFrame:
     """Side by side, for each (kind, R, Theta) of ``cases``: the range of p (rad), peak and mean
-    F (N), peak |beta| (rad) and C's largest distance from the path (m), for each law."""
+    F (N), peak |beta| (rad) and C's largest distance from the path (m), for each law.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    cases : iterable of tuple
+        (kind, R (m), Theta (rad/s)) triples; kind ``"eight"`` or ``"circle"``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Two rows per case (law ``"C (paper)"`` by :func:`paper_steady`, then ``"P (percussion)"`` by
+        :func:`percussion_steady`), columns path, R (m), Theta (rad/s), law, p_range (rad),
+        F_peak (N), F_mean (N), beta_peak (rad), C_distance (m; 0 for the paper's law, C being on
+        the path, else over every 8th sample).
+    """
     rows = []
     for kind, R, Theta in cases:
         for law, fn in (("C (paper)", paper_steady), ("P (percussion)", percussion_steady)):

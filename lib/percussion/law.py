@@ -5,7 +5,7 @@ is singular. With the thrust u1 made a state xi (an integrator, xi' = nu), P''' 
 (nu, u2) through a matrix with determinant -(c/m - c_phi/I_C)/m^2, regular for the book's
 body. Writing P''' from :mod:`lib.percussion.point`,
 
-    P''' = (nu/m) e1 + omega' (-2 s_P omega e1 + eps/s_P * s_P e2) + (xi/m - s_P omega^2) omega e2
+    P''' = (nu/m) e1 + omega' (-2 s_P omega e1 + eps e2) + (xi/m - s_P omega^2) omega e2
            - k P'' - eps omega^2 e1,
 
 the law asks P''' = D := P_d''' + k2 e'' + k1 e' + k0 e (e = P_d - P), i.e.
@@ -62,6 +62,28 @@ def law_inputs(body: Body, coeffs: np.ndarray, ref_kin, z, dz, xi) -> tuple[np.n
 
     ``ref_kin`` = (P_d, P_d', P_d'', P_d''') each (..., 2); ``coeffs`` from
     :func:`error_polynomial`. Unvalidated kernel.
+
+    Parameters
+    ----------
+    body : Body
+        The body (m, I_C, a, c, c_phi).
+    coeffs : numpy.ndarray
+        (2, 3): k2 (1/s), k1 (1/s^2), k0 (1/s^3) per axis x, y (:func:`error_polynomial`).
+    ref_kin : tuple of numpy.ndarray
+        (P_d (m), P_d' (m/s), P_d'' (m/s^2), P_d''' (m/s^3)), each (..., 2).
+    z : numpy.ndarray
+        C's configuration (x, y, phi) (m, m, rad), (..., 3).
+    dz : numpy.ndarray
+        Its rate (m/s, m/s, rad/s), (..., 3).
+    xi : numpy.ndarray
+        The thrust state xi = F cos beta (N), (...).
+
+    Returns
+    -------
+    nu : numpy.ndarray
+        The thrust's rate xi' (N/s), (...).
+    u2 : numpy.ndarray
+        The lateral force F sin beta (N), (...).
     """
     s, eps, k, m = centre_of_percussion(body), lateral_drag_speed(body), body.c / body.m, body.m
     phi, om = z[..., 2], dz[..., 2]
@@ -81,7 +103,26 @@ def law_inputs(body: Body, coeffs: np.ndarray, ref_kin, z, dz, xi) -> tuple[np.n
 
 def applied_force(xi, u2, force_cap=None, angle_cap=None) -> tuple[np.ndarray, np.ndarray]:
     """(F, beta) of the body-frame force (xi, u2) (N), with F clipped to ``force_cap`` (N) and
-    beta to |beta| <= ``angle_cap`` (rad) when given (the paper's Sec. 5 limits)."""
+    beta to |beta| <= ``angle_cap`` (rad) when given (the paper's Sec. 5 limits).
+
+    Parameters
+    ----------
+    xi : array_like
+        Thrust along the body axis, F cos beta (N).
+    u2 : array_like
+        Lateral force, F sin beta (N), broadcastable with ``xi``.
+    force_cap : float, optional
+        F_max (N); None for no cap.
+    angle_cap : float, optional
+        beta_max (rad); None for no limit.
+
+    Returns
+    -------
+    F : numpy.ndarray
+        Force magnitude (N), >= 0, the broadcast shape of ``xi`` and ``u2``.
+    beta : numpy.ndarray
+        Force angle from the body axis (rad), in [-pi, pi], same shape.
+    """
     F, beta = np.hypot(xi, u2), np.arctan2(u2, xi)
     if angle_cap is not None:
         beta = np.clip(beta, -angle_cap, angle_cap)
@@ -92,7 +133,30 @@ def applied_force(xi, u2, force_cap=None, angle_cap=None) -> tuple[np.ndarray, n
 
 def closed_loop_rates(body: Body, coeffs, ref_kin, y, limits=None):
     """Rates of the closed loop's state y = (x, y, phi, x', y', phi', xi) (..., 7) under the
-    law, and the applied (F, beta). Unvalidated kernel."""
+    law, and the applied (F, beta). Unvalidated kernel.
+
+    Parameters
+    ----------
+    body : Body
+        The plant (and the law's model).
+    coeffs : numpy.ndarray
+        (2, 3) from :func:`error_polynomial` (1/s, 1/s^2, 1/s^3).
+    ref_kin : tuple of numpy.ndarray
+        (P_d (m), P_d' (m/s), P_d'' (m/s^2), P_d''' (m/s^3)), each (..., 2).
+    y : numpy.ndarray
+        The state (m, m, rad, m/s, m/s, rad/s, N), (..., 7).
+    limits : Limits, optional
+        :class:`lib.allocation.Limits` applied to (F, beta); None for none.
+
+    Returns
+    -------
+    rates : numpy.ndarray
+        y' (m/s, m/s, rad/s, m/s^2, m/s^2, rad/s^2, N/s), (..., 7).
+    F : numpy.ndarray
+        The applied force magnitude (N), (...).
+    beta : numpy.ndarray
+        Its angle from the body axis (rad), (...).
+    """
     z, dz, xi = y[..., :3], y[..., 3:6], y[..., 6]
     nu, u2 = law_inputs(body, coeffs, ref_kin, z, dz, xi)
     fc = None if limits is None else limits.force

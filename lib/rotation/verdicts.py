@@ -25,7 +25,7 @@ from ..dynamics import verdicts as dv
 from ..dynamics.orbits import floquet_multipliers
 from ..machinery.parallel import concat_frames, map_chunks
 from ..params import Body
-from .reduced import ENGINES, _check_grid, _initial
+from .reduced import ENGINES, _check_grid, _initial, check_domain
 from .engine import RotationMap, _Engine, orbit_range, verdict_steps
 from .field import coefficients
 
@@ -237,6 +237,7 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
     checks.one_of("engine", engine, sorted(ENGINES))
     R, Theta = _check_grid(R, Theta)
     h_lambda = checks.number("h_lambda", h_lambda, positive=True)
+    check_domain(body, kind, R, Theta, h_lambda)
     opts = _verdict_options(options)
     N = R.size
     p0, v0 = checks.array("p0", p0), checks.array("v0", v0)

@@ -84,7 +84,8 @@ def verdict_runs(body: Body, gains: Gains, runs: dict, **options) -> dict:
         R, Theta, w = _points(r["R"], r["Theta"], r.get("weights", (1.0, 1.0, 0.0)))
         ref = [np.concatenate(KINEMATICS[r["kind"]](R, Theta, 0.0)[:2], axis=1)] if r["kind"] in KINEMATICS else None
         if ref is None:
-            raise ValueError(f"unknown trajectory {r['kind']!r} in run {name!r}; known: {sorted(KINEMATICS)}")
+            raise ValueError(f"runs[{name!r}]['kind'] must be one of {sorted(KINEMATICS)} (the trajectory), "
+                             f"got {r['kind']!r}")
         s0 = ref[0]
         for key, sl in (("z0", slice(0, 3)), ("dz0", slice(3, 6))):
             if r.get(key) is not None:

@@ -36,6 +36,8 @@ def _points(R, Theta, weights):
     w = checks.array("weights", weights, nonnegative=True)
     if w.ndim == 0 or not np.all(np.any(w > 0, axis=-1)):
         raise ValueError(f"weights (w_x, w_y, w_phi) must be non-negative and not all zero, got {weights!r}")
+    if w.shape[-1] != 3:
+        raise ValueError(f"weights must be (w_x, w_y, w_phi): 3 numbers or an (N, 3) array, got shape {w.shape}")
     if w.ndim == 1:
         w = np.broadcast_to(w, (max(R.size, Theta.size), 3))
     if R.ndim != 1 or Theta.ndim != 1 or w.ndim != 2 or w.shape[1] != 3:
@@ -49,13 +51,13 @@ def _points(R, Theta, weights):
         raise ValueError(f"R ({R.size}), Theta ({Theta.size}) and weights ({w.shape[0]}) must have equal "
                          "lengths (or length 1)") from None
     if not np.all(Theta != 0):
-        raise ValueError(f"Theta{list(np.argwhere(Theta == 0)[0])} must be non-zero (rad/s)")
+        raise ValueError(f"Theta[{int(np.flatnonzero(Theta == 0)[0])}] must be non-zero (rad/s)")
     return R, Theta, w
 
 
 def _check_loop(body, gains, kind, allocation, limits) -> Limits:
     if kind not in KINEMATICS:
-        raise ValueError(f"unknown trajectory {kind!r}; known: {sorted(KINEMATICS)}")
+        raise ValueError(f"kind must be one of {sorted(KINEMATICS)} (the trajectory), got {kind!r}")
     checks.instance("body", body, Body)
     checks.instance("gains", gains, Gains)
     if allocation not in ("least_squares", "limited"):
