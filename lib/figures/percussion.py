@@ -11,7 +11,21 @@ __all__ = ["plot_percussion_map", "plot_steady_pair"]
 
 def plot_percussion_map(frame, ax=None):
     """The range of the heading error p (rad) over (R, Theta) from a
-    :func:`lib.percussion.rotation_sweep` frame; lost points as black crosses. Returns the figure."""
+    :func:`lib.percussion.rotation_sweep` frame; lost points as black crosses. Returns the figure.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        A frame of :func:`lib.percussion.rotation_sweep` (or
+        :func:`lib.percussion.percussion_fig5_map`): columns R (m), Theta (rad/s), range (rad), lost.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw; a new figure when None.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure of ``ax``, with a colour bar of the range of p (rad).
+    """
     fig, ax = (plt.subplots(figsize=(6.4, 4.2)) if ax is None else (ax.figure, ax))
     sc = ax.scatter(frame.R, frame.Theta, c=frame["range"], s=6, cmap="viridis", marker="s")
     lost = frame[frame.lost]
@@ -26,7 +40,23 @@ def plot_percussion_map(frame, ax=None):
 
 def plot_steady_pair(paper, ours, ax=None):
     """One period of the steady motions of the paper's law (C on the path) and of the law for P
-    (P on the path): the heading error p (rad) and the force F (N) against t / T. ``ax``: two axes."""
+    (P on the path): the heading error p (rad) and the force F (N) against t / T. ``ax``: two axes.
+
+    Parameters
+    ----------
+    paper : SteadyMotion
+        The paper's law, :func:`lib.percussion.paper_steady`: t (s), p (rad), F (N).
+    ours : SteadyMotion
+        The law for P, :func:`lib.percussion.percussion_steady`.
+    ax : sequence of matplotlib.axes.Axes, optional
+        Two axes, for p (rad) and F (N); a new figure of two when None.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure; t / T is t over each motion's last sample time (its period T, s), p is
+        unwrapped, and a dotted line marks F = 4 N.
+    """
     if ax is None:
         fig, ax = plt.subplots(1, 2, figsize=(9, 3.4))
     else:

@@ -35,8 +35,25 @@ _G = np.array([0.5 - np.sqrt(3) / 6, 0.5 + np.sqrt(3) / 6])
 
 
 def coefficients(body: Body, R, Theta) -> tuple[np.ndarray, np.ndarray]:
-    """(cA, cV) with alpha = cA Y'' + cV Y', beta = cA X'' + cV X'': cA = R Theta / eps,
-    cV = R k / eps (dimensionless per unit phase)."""
+    """(cA, cV) with alpha = cA Y'' + cV Y', beta = cA X'' + cV X': cA = R Theta / eps,
+    cV = R k / eps (dimensionless per unit phase).
+
+    Parameters
+    ----------
+    body : Body
+        The body (its eps = :func:`lib.percussion.point.lateral_drag_speed` and k = c/m).
+    R : array_like
+        Sizes of the path (m).
+    Theta : array_like
+        Rates of the reference (rad/s), broadcastable with ``R``.
+
+    Returns
+    -------
+    cA : numpy.ndarray
+        R Theta / eps (dimensionless), the broadcast shape of ``R`` and ``Theta``.
+    cV : numpy.ndarray
+        R (c/m) / eps (dimensionless), the shape of ``R``.
+    """
     eps = lateral_drag_speed(body)
     R, Theta = np.asarray(R, float), np.asarray(Theta, float)
     return R * Theta / eps, R * (body.c / body.m) / eps

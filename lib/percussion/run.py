@@ -31,7 +31,21 @@ class PercussionResult(SimulationResult):
 
 
 def reference_point_kinematics(ref: Reference, t) -> tuple:
-    """(P_d, P_d', P_d'', P_d''') at times t (s), each (n, 2)."""
+    """(P_d, P_d', P_d'', P_d''') at times t (s), each (n, 2).
+
+    Parameters
+    ----------
+    ref : Reference
+        The path of P (its x, y; exact for the circle (27) and the eight (28), else the jerk
+        by finite differences, :func:`lib.trajectories.position_kinematics`).
+    t : float or array_like
+        Times (s), a scalar or 1-D (n,).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (P_d (m), P_d' (m/s), P_d'' (m/s^2), P_d''' (m/s^3)), each (n, 2) (n = 1 for a scalar t).
+    """
     kin = position_kinematics(ref)
     rows = np.array([kin(tt) for tt in np.atleast_1d(t)])
     return tuple(rows[:, 2 * j:2 * j + 2] for j in range(4))

@@ -22,6 +22,7 @@ from ..dynamics import verdicts as dv
 from ..machinery.parallel import concat_frames, map_chunks
 from ..params import Body
 from ..rotation.reduced import _check_grid
+from ..rotation.verdicts import FIG5_GRID
 from ..dynamics.sampled import sampled_range
 from .engine import HeadingEngine, HeadingMap, coefficients
 
@@ -96,8 +97,8 @@ def rotation_sweep(body: Body, R, Theta, *, kind: str = "eight", p0=0.0, executo
     return concat_frames(parts)
 
 
-def percussion_fig5_map(body: Body, R_range=(0.25, 4.0), Theta_range=(0.05, 1.5), n: int = 100,
-                        **kw) -> pd.DataFrame:
+def percussion_fig5_map(body: Body, R_range=FIG5_GRID["R"], Theta_range=FIG5_GRID["Theta"],
+                        n: int = FIG5_GRID["n"], **kw) -> pd.DataFrame:
     """:func:`rotation_sweep` on the n x n grid of Fig. 5 (Theta varying slowest), as
     :func:`lib.rotation.verdicts.fig5_map` lays it out.
 
@@ -106,9 +107,9 @@ def percussion_fig5_map(body: Body, R_range=(0.25, 4.0), Theta_range=(0.05, 1.5)
     body : Body
         The body.
     R_range, Theta_range : tuple
-        The grid's ranges (m, rad/s).
+        The grid's ranges (m, rad/s); default those of :data:`lib.rotation.verdicts.FIG5_GRID`.
     n : int
-        Points per side.
+        Points per side (>= 2); default ``FIG5_GRID["n"]``.
     **kw
         Keywords of :func:`rotation_sweep`.
 
