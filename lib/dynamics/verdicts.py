@@ -7,7 +7,7 @@ the full closed loop under any allocation) supplies only that map and which of i
 coordinates is the heading, which may advance by whole turns; the steps below, and
 the words they decide, are written here once.
 
-The words (the book's definition ``def-regimes``, Chapter 5):
+The words (the book's definition ``def-regimes``, on its Methods page):
 
 ``periodic``
     Newton on P^k(x) = x (k <= ``max_period``) converges, every Floquet multiplier

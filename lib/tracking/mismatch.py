@@ -206,7 +206,7 @@ def mismatch_sweep(body: Body, gains: Gains, kind, R, Theta, mismatch: Mapping, 
     Each point runs the full closed loop (2)-(4), (23), (25)-(26) from the Table's start
     (``z0``, ``dz0``), (23) with the model ``body`` scaled by 1 + delta, by the batch RK4 of
     :func:`lib.weighting.verdicts.closed_loop_verdicts` and decided by the same procedure
-    (:mod:`lib.dynamics.verdicts`; the words are Chapter 5's, ``def-regimes``), with the same
+    (:mod:`lib.dynamics.verdicts`; the words of ``def-regimes``, the Methods page), with the same
     ``options`` (:data:`lib.weighting.verdicts.LOOP_VERDICT_DEFAULTS`). With every delta = 0 it is
     that function's run of the paper's law.
 
