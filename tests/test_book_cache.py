@@ -1,6 +1,7 @@
 """lib.machinery.cache: one computation shared by two pages of one build, never a stale one."""
 
 import time
+from pathlib import Path
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -72,3 +73,12 @@ def test_two_callers_at_once_compute_the_key_once(book):
     with ThreadPoolExecutor(2) as ex:
         a, b = ex.map(lambda _: book_cache.cached(_slow_square, np.arange(3.0)), range(2))
     assert len(CALLS) == 1 and np.array_equal(a, b)
+
+
+def test_the_key_reads_every_folder_of_the_library():
+    # a change to a chapter's module (lib/rotation/verdicts.py, say) must compute afresh: the key
+    # hashes the whole package, not the folder the cache module sits in
+    import lib
+    assert book_cache._LIB == Path(lib.__file__).resolve().parent
+    hashed = {p.relative_to(book_cache._LIB).parts[0] for p in book_cache._LIB.rglob("*.py")}
+    assert {"rotation", "limits", "weighting", "dynamics", "params.py"} <= hashed

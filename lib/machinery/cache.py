@@ -29,7 +29,7 @@ except ImportError:  # not POSIX: no lock, a key may then be computed twice at o
 
 __all__ = ["cached", "cached_timed", "cache_dir"]
 
-_LIB = Path(__file__).resolve().parent
+_LIB = Path(__file__).resolve().parents[1]          # the package lib/, every folder of it
 
 
 def cache_dir(start: Path | None = None) -> Path:
