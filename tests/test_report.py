@@ -30,3 +30,12 @@ def test_outcome_rejects_unknown_status_and_non_finite_merit():
         report.Outcome("fine", 0.0, "x")
     with pytest.raises(ValueError, match="finite"):
         report.Outcome("reproduced", float("nan"), "x")
+
+
+def test_the_front_page_states_report_rows_with_the_status_each_row_claims():
+    # intro.md's findings read these rows (lib.paper.findings); a finding cannot claim another
+    # status than the row's check is required to decide
+    from lib.paper.findings import FINDINGS
+    expected = {it.key: it.expected for it in report.items()}
+    assert set(FINDINGS) <= set(expected)
+    assert {k: expected[k] for k in FINDINGS} == FINDINGS
