@@ -28,7 +28,7 @@ def test_readme_library_example_runs():
     assert header.split() == ["R", "Theta", "regime", "range", "lost"]
     assert len(rows) == 9 and {r.split()[3] for r in rows} <= {"periodic", "slipping", "chaotic",
                                                                 "quasiperiodic", "undecided"}
-    assert float(last.split()[0]) <= 4.0 + 1e-15          # measured 0 over the cap; F never above the cap
+    assert float(last.split()[0]) <= 4.0 + 1e-15          # exact: a clip; measured 0 over the cap; F never above the cap
 
 
 def test_readme_notebook_route_uses_installed_tools():
