@@ -11,6 +11,7 @@ from lib import limits, loop_verdicts, rotation_verdicts, stability
 from lib.angles import wrap_angle
 from lib.circle_rotation import circle_critical_radius, circle_eigenvalues
 from lib.dynamics import verdicts as dv
+from lib.dynamics.orbits import newton_orbit
 from lib.params import Body
 from lib.rotation_engine import RotationMap, _Engine
 from lib.rotation_field import coefficients
@@ -754,3 +755,108 @@ def test_section_returns_judge_the_state_at_a_third_of_the_run_too():
     r = dv.section_returns(sec, angles=())
     assert r[0] > 0.2            # measured 0.223: about (1.6 - 1) / 2.6, the outlier's gap over D
     assert dv.section_returns(np.delete(sec, L // 3, axis=0), angles=())[0] < 0.05  # measured 0.021 without it
+
+
+# ------------------------------------------- bug classes: chains of divisors, complex multipliers
+# (issue 28: a least period trying its divisors in ascending order, and stability judged by
+# the real part of a multiplier, both passed the suite)
+
+def _images(x, period, lag, slip=(0.0, 0.0)):
+    """pts (lag, 1, 2) of a point of least period ``period``: P^j(x) = x + (j / period) slip
+    where period divides j, and 0.1 away (in x) elsewhere."""
+    pts = np.empty((lag, 1, 2))
+    for j in range(1, lag + 1):
+        pts[j - 1, 0] = x[0] + (np.array(slip) * j / period if j % period == 0 else [0.1, 0.0])
+    return pts
+
+
+@pytest.mark.parametrize("lag, period", [(4, 1), (4, 2), (6, 1), (6, 2), (6, 3), (8, 1), (8, 2), (8, 4),
+                                         (6, 6), (8, 8)])
+def test_least_period_is_the_smallest_divisor_along_a_chain_of_divisors(lag, period):
+    # lag 8 of a period-2 orbit: its divisors 2 and 4 both return, 1 does not; the least
+    # period is 2 (trying the divisors in the other order would report 4)
+    x = np.array([[0.5, 0.2]])
+    pts = _images(x, period, lag)
+    k, n = dv.least_period(x, pts, np.array([lag]), np.array([0]), turn_axis=1, tol=1e-9)
+    assert (k[0], n[0]) == (period, 0)
+    # slipping: one turn of the heading per period, so lag / period turns at the lag
+    pts = _images(x, period, lag, slip=(0.0, TWO_PI))
+    k, n = dv.least_period(x, pts, np.array([lag]), np.array([lag // period]), turn_axis=1, tol=1e-9)
+    assert (k[0], n[0]) == (period, 1)
+    k, n = dv.least_period(x, pts, np.array([lag]), np.array([lag // period]), turn_axis=1, turns=False,
+                           tol=1e-9)
+    assert (k[0], n[0]) == ((lag, lag // period) if period < lag else (period, 1))
+
+
+def test_least_period_of_several_rows_takes_each_rows_own_divisors():
+    # rows of lags 4, 6, 8 and 8 at once (NaN past a row's own lag), least periods 1, 3, 2, 8
+    x = np.array([[0.5, 0.2], [0.1, -1.0], [2.0, 0.0], [0.0, 3.0]])
+    rows = [(4, 1), (6, 3), (8, 2), (8, 8)]
+    pts = np.full((8, 4, 2), np.nan)
+    for i, (lag, period) in enumerate(rows):
+        pts[:lag, i] = _images(x[i:i + 1], period, lag)[:, 0]
+    k, _ = dv.least_period(x, pts, np.array([4, 6, 8, 8]), np.zeros(4, int), turn_axis=1, tol=1e-9)
+    assert k.tolist() == [1, 3, 2, 8]
+
+
+class FocusMap:
+    """P(x) = c + r R(theta) (x - c), R a rotation: a focus at c with the complex multipliers
+    r exp(+-i theta), one (r, theta) per row; column 1 the heading (``turn_axis`` 1)."""
+
+    turn_axis = 1
+
+    def __init__(self, r, theta, c=(0.0, 0.3)):
+        self.r, self.theta, self.c = np.atleast_1d(r), np.atleast_1d(theta), np.asarray(c, dtype=float)
+
+    def step(self, idx, X, k):
+        idx = np.asarray(idx)
+        k = np.broadcast_to(np.asarray(k, dtype=int), (len(idx),))
+        a, s = self.r[idx] ** k, self.theta[idx] * k
+        A = a[:, None, None] * np.stack([np.stack([np.cos(s), -np.sin(s)], -1),
+                                         np.stack([np.sin(s), np.cos(s)], -1)], -2)
+        return self.c + np.einsum("mij,mj->mi", A, np.asarray(X, dtype=float) - self.c), A
+
+    def advance(self, idx, X, k):
+        return self.step(idx, X, k)[0]
+
+    def run(self, x0, L):
+        out = [np.array(x0, dtype=float)]
+        for _ in range(L - 1):
+            out.append(self.advance(np.arange(len(out[0])), out[-1], 1))
+        return np.stack(out)
+
+
+@pytest.mark.parametrize("r, found", [(0.98, True), (0.995, True), (1.005, False), (1.02, False)])
+@pytest.mark.parametrize("theta", [1.3, math.pi / 2, 2.9])
+def test_a_focus_is_attracting_by_the_modulus_of_its_complex_multipliers(r, found, theta):
+    # |mu| = r just below or above 1, mu complex: |Re mu| = r |cos theta| < 1 every time, so a
+    # stability judged by the real part would take the repelling focus as attracting
+    pm = FocusMap([r], [theta])
+    out = _find(pm, _standing(pm.c, 13))
+    assert out["status"].tolist() == ["found" if found else "not attracting"]
+    assert out["found"].tolist() == [found] and out["k"].tolist() == [1 if found else 0]
+    # the last attempt's |mu|: lag 1 for the attracting focus, lag 4 (max_period) for the
+    # repelling one, tried at every lag
+    want = r if found else r ** OPTS["max_period"]
+    assert out["floquet"][0] == pytest.approx(want, rel=1e-12)  # accuracy: the eigensolver on a normal matrix: the floor
+    # and an orbit's own verdict (lib.dynamics.orbits.Orbit.attracting)
+    orb = newton_orbit(lambda x: pm.step(np.zeros(len(x), int), x, 1), pm.c + [[1e-3, -2e-3]], 1)
+    assert orb.converged[0] and orb.attracting[0] == (r < 1)
+    mu = orb.multipliers[0]
+    assert abs(mu[0].imag) > 0.1 and abs(mu[0].real) < 1  # reason: the case that tells |mu| from |Re mu|
+
+
+def test_a_focus_returning_at_lag_four_but_not_at_lag_one_is_a_fixed_point():
+    # a quarter turn a period, slowly contracting: the run returns near itself at lag 4 (the
+    # lag-4 defect 6e-4 is within candidate_tol 1e-3), not at lags 1-3 (1e-2 and more).
+    # Newton on P^4 lands on the focus, whose P^1 and P^2 both return it: least period 1
+    pm = FocusMap([0.98], [math.pi / 2])
+    runs = pm.run([pm.c + [0.01, 0.0]], 13)
+    cand, _, defect = dv.lag_candidates(runs, 4, OPTS["candidate_tol"], turn_axis=1, ends=2)
+    assert cand[:, 0].tolist() == [False, False, False, True]
+    out = _find(pm, runs)
+    assert out["status"].tolist() == ["found"]
+    assert (out["k"][0], out["lag"][0], out["n"][0]) == (1, 4, 0)
+    # rho is the least period's: |mu(P^4)|^(1/4) = 0.98
+    assert out["rho"][0] == pytest.approx(0.98, rel=1e-12)  # accuracy: the eigensolver on a normal matrix: the floor
+    np.testing.assert_allclose(out["x"][0], pm.c, rtol=0, atol=1e-12)  # accuracy: Newton on a linear map, newton_tol 1e-12
