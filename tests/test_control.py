@@ -87,3 +87,24 @@ def test_error_dynamics_solution_solves_eq24():
     resid = m * dde + gains.kv * de + gains.kp * e
     assert np.abs(resid[5:-5]).max() < 1e-4  # measured 2.7e-5: the O(h^2) error of np.gradient's second difference
     np.testing.assert_allclose(e[0], [1.0, -0.5, 0.2], atol=1e-14)  # exact: the closed form's initial value; measured 0
+
+
+@settings(max_examples=60, deadline=None)
+@given(t=st.floats(0.0, 30.0), z=vec3, dz=vec3, kind=st.sampled_from(["circle", "eight"]))
+def test_computed_torque_off_the_reference_gives_the_error_equation_24(t, z, dz, kind):
+    """Off the reference (e != 0, de != 0), the plant M ddz + N(dz) = tau driven by (23) has
+    M e'' + Kv e' + Kp e = 0 (24), e = z_d - z: (23)'s drag term must cancel the plant's drag
+    at the actual rate dz. The drag of the reference rate dz_d would leave N(dz - dz_d) in (24),
+    which no test on the reference (e = 0) sees (issue 28)."""
+    body, gains = Body(), Gains(kp=[5.2, 3.0, 1.0], kv=[1.0, 2.0, 0.5])
+    ref = T.make(kind, 1.7, 0.6)
+    z, dz = np.asarray(z) / 10, np.asarray(dz) / 10
+    tau = control.computed_torque(body, gains, ref, t, z, dz)
+    m = np.array([body.m, body.m, body.I])
+    ddz = (tau - body.drag * dz) / m                     # the plant (2)-(4) in configuration form
+    e, de, dde = ref.z(t) - z, ref.dz(t) - dz, ref.ddz(t) - ddz
+    resid = m * dde + gains.kv * de + gains.kp * e
+    scale = 1 + np.abs(m * ref.ddz(t)).max() + np.abs(body.drag * dz).max() + np.abs(gains.kv * de).max() \
+        + np.abs(gains.kp * e).max()
+    # exact: a closed form, to the rounding of its terms
+    np.testing.assert_allclose(resid, 0.0, rtol=0, atol=1e-14 * scale)
