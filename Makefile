@@ -49,7 +49,7 @@ test: $(STAMP)
 # the x86-64-v2 baseline (AVX2/FMA3, AVX-512) are switched off; BLAS, OpenMP and numba run one
 # thread, so no reduction is split differently. A bound that holds only on this CPU fails here.
 PORTABLE_ENV := NUMBA_CPU_NAME=generic NUMBA_CACHE_DIR=$(CURDIR)/_build/numba-generic \
-	OPENBLAS_CORETYPE=Prescott NPY_DISABLE_CPU_FEATURES="X86_V3 X86_V4 AVX512_ICL" \
+	OPENBLAS_CORETYPE=Prescott NPY_DISABLE_CPU_FEATURES="X86_V3 X86_V4 AVX512_ICL AVX512_SPR" \
 	NUMBA_NUM_THREADS=1 OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1 \
 	PYTHONHASHSEED=0
 
