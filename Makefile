@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: book test benchmark clean mutation
+.PHONY: book test test-portable benchmark clean mutation
 
 $(STAMP): requirements.txt pyproject.toml
 	@echo "Installing .venv from requirements.txt and pyproject.toml (a few minutes the first time)..."
@@ -41,6 +41,21 @@ test: $(STAMP)
 	wait; \
 	BOOK_REBUILD= $(BIN)/python -m pytest -m "book or browser"; slow=$$?; \
 	test $$fast = 0 && test $$slow = 0
+
+# The fast tests again under another machine's arithmetic, emulated on this one (README:
+# "Another machine's arithmetic"): numba compiles for its generic x86-64 target (no AVX, no
+# FMA contraction) into a cache of its own, so that it neither reads nor overwrites the native
+# one; OpenBLAS (numpy's and scipy's) runs its most generic kernel; numpy's SIMD loops above
+# the x86-64-v2 baseline (AVX2/FMA3, AVX-512) are switched off; BLAS, OpenMP and numba run one
+# thread, so no reduction is split differently. A bound that holds only on this CPU fails here.
+PORTABLE_ENV := NUMBA_CPU_NAME=generic NUMBA_CACHE_DIR=$(CURDIR)/_build/numba-generic \
+	OPENBLAS_CORETYPE=Prescott NPY_DISABLE_CPU_FEATURES="X86_V3 X86_V4 AVX512_ICL AVX512_SPR" \
+	NUMBA_NUM_THREADS=1 OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1 \
+	PYTHONHASHSEED=0
+
+test-portable: $(STAMP)
+	@mkdir -p _build/numba-generic
+	$(PORTABLE_ENV) nice -n 10 $(BIN)/python -m pytest -n 2 -m "not book and not browser" -p no:cacheprovider
 
 benchmark: $(STAMP)
 	$(BIN)/python benchmarks/bench_switched.py

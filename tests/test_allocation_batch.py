@@ -108,7 +108,7 @@ def test_stability_boundary_reads_the_first_change_of_verdict():
     f["tracked"] = ~f.position_lost
     b = weighting.stability_boundary([0.0, 0.1, 0.2, 0.4], f)
     assert (b["last_held"], b["first_lost"], b["changes"]) == (0.1, 0.2, 2)
-    assert b["verdict"] == "chaotic, position not tracked" and b["ratio"] == pytest.approx(2.0, abs=1e-15)  # measured 0
+    assert b["verdict"] == "chaotic, position not tracked" and b["ratio"] == pytest.approx(2.0, abs=1e-15)  # exact: a ratio of two grid values; measured 0
     with pytest.raises(ValueError, match="increasing"):
         weighting.stability_boundary([0.1, 0.0, 0.2, 0.3], f)
 
@@ -126,7 +126,7 @@ def test_batch_with_limits_agrees_with_adaptive_simulation(law, angle):
                      limits=lim, integration=Integration(rtol=1e-9, atol=1e-9))
     assert np.abs(b.z[:, 0] - exact.z).max() < 5e-5  # measured 7.1e-6
     assert np.abs(b.F[:, 0] - exact.F).max() < 2e-4  # measured 1.8e-5
-    assert b.F.max() <= 4.0 + 1e-15  # measured 0 over the cap
+    assert b.F.max() <= 4.0 + 1e-15  # exact: a clip; measured 0 over the cap
 
 
 def test_batch_allocation_and_limits_are_validated():

@@ -14,7 +14,7 @@ def test_rk4_on_a_linear_equation_is_its_degree_4_taylor_polynomial_per_step():
     h, n = 0.1, 37
     _, y = batch.integrate(lambda t, y: lam * y, np.ones(3, complex), 0.0, n * h, h, batch.RK4)
     z = lam * h
-    np.testing.assert_allclose(y[-1], (1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24) ** n, rtol=1e-13)  # measured 3.5e-15
+    np.testing.assert_allclose(y[-1], (1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24) ** n, rtol=1e-13)  # exact: RK4's closed form on a linear equation, rounding of 37 steps; measured 3.5e-15
 
 
 @pytest.mark.parametrize("tableau,order", [(batch.RK4, 4), (batch.dop853(), 8)])
@@ -40,7 +40,7 @@ def test_points_are_independent_rows():
 
 def test_recording_and_blow_up():
     t, y = batch.integrate(lambda t, y: y, np.ones(1), 0.0, 1.0, 0.1, batch.RK4, record_every=3)
-    np.testing.assert_allclose(t, [0.0, 0.3, 0.6, 0.9, 1.0], rtol=0, atol=1e-15)  # measured 1.1e-16
+    np.testing.assert_allclose(t, [0.0, 0.3, 0.6, 0.9, 1.0], rtol=0, atol=1e-15)  # exact: the record times, sums of the step; measured 1.1e-16
     with pytest.raises(FloatingPointError, match="non-finite at t = .* for point 1"), np.errstate(over="ignore",
                                                                                               invalid="ignore"):
         batch.integrate(lambda t, y: np.array([[0.0], [1.0]]) * y**2, np.ones((2, 1)), 0.0, 5.0, 0.05)

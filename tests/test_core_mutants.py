@@ -41,7 +41,7 @@ def test_state_difference_wraps_the_heading_entry_only():
     d = state_difference(a, b)
     # x, y and the rates: plain differences (the rates 6 - (-6) = 12 rad/s stay 12)
     np.testing.assert_array_equal(d[[0, 1, 3, 4, 5]], (a - b)[[0, 1, 3, 4, 5]])
-    # the heading: 3 - (-3) = 6 rad is the turn 6 - 2 pi
+    # exact: a closed form; the heading: 3 - (-3) = 6 rad is the turn 6 - 2 pi
     assert d[2] == pytest.approx(6.0 - 2 * math.pi, abs=1e-15)  # measured 0
     assert d.dtype == float
 
@@ -58,7 +58,7 @@ def test_state_difference_works_on_batches_of_states_and_leaves_its_inputs_alone
     np.testing.assert_array_equal(np.delete(d, 2, axis=-1), np.delete(a - b, 2, axis=-1))
     # integer states: the heading's wrapped difference is not truncated to an integer
     di = state_difference([0, 0, 4, 0, 0, 0], [0, 0, 0, 0, 0, 0])
-    assert di[2] == pytest.approx(4 - 2 * math.pi, abs=1e-15)  # measured 0
+    assert di[2] == pytest.approx(4 - 2 * math.pi, abs=1e-15)  # exact: a closed form; measured 0
 
 
 # ------------------------------------------------------------------ model
@@ -71,9 +71,9 @@ def test_printed_drift_is_the_derived_one_plus_twice_v1_omega_in_the_v2_row_nume
     diff = model.f_printed(Body(), q) - model.f(Body(), q)
     expected = np.zeros_like(q)
     expected[:, 4] = 2 * q[:, 3] * q[:, 5]
-    np.testing.assert_allclose(diff, expected, rtol=1e-14, atol=1e-14)  # measured 0
+    np.testing.assert_allclose(diff, expected, rtol=1e-14, atol=1e-14)  # exact: two closed forms of (2)-(4); measured 0
     np.testing.assert_allclose(model.state_rhs(Body(), q, 1.5, 0.3, printed=True)
-                               - model.state_rhs(Body(), q, 1.5, 0.3), expected, rtol=1e-14, atol=1e-14)  # measured 0
+                               - model.state_rhs(Body(), q, 1.5, 0.3), expected, rtol=1e-14, atol=1e-14)  # exact: two closed forms of (2)-(4); measured 0
 
 
 def test_drift_of_a_batch_of_states_is_the_drift_of_each():
@@ -122,8 +122,8 @@ def test_closed_loop_rates_of_a_batch_are_the_rates_of_each_state():
     assert rates.shape == (4, 6) and F.shape == (4,)
     for i in range(4):
         r_i, F_i = loop.rates(1.3, s[i])
-        np.testing.assert_allclose(rates[i], r_i, rtol=1e-15, atol=1e-15)  # measured 0
-        assert F[i] == pytest.approx(float(F_i), rel=1e-15, abs=0)  # measured 0
+        np.testing.assert_allclose(rates[i], r_i, rtol=1e-15, atol=1e-15)  # exact: one code path, batched and per point; measured 0
+        assert F[i] == pytest.approx(float(F_i), rel=1e-15, abs=0)  # exact: one code path, batched and per point; measured 0
 
 
 def test_closed_loop_uses_the_allocation_it_is_given():
@@ -184,7 +184,9 @@ def test_eight_heading_oscillates_about_pi_forwards_and_about_zero_backwards():
         ref = T.eight(2.0, theta)
         t = np.linspace(0.0, ref.period, 2001)[:-1]
         h = ref.heading(t)
-        assert abs(h.mean() - mean) < 5e-15 and np.all(np.abs(h - mean) < math.pi)  # measured 4.5e-16
+        # exact: a closed form, the mean's rounding: 11 levels of a pairwise sum of values up
+        # to 2 pi, 11 x 2 pi x eps = 1.5e-14 (measured 4.5e-16)
+        assert abs(h.mean() - mean) < 2e-14 and np.all(np.abs(h - mean) < math.pi)
 
 
 def test_position_kinematics_of_a_path_runs_on_python_floats():
@@ -196,7 +198,7 @@ def test_position_kinematics_of_a_path_runs_on_python_floats():
 
 def test_eight_heading_fourier_coefficients_are_the_cosine_integrals():
     # a_k = (1/pi) int_0^{2 pi} phi_d(s) cos(k s) ds (a_0 the mean), by adaptive quadrature;
-    # measured agreement 3.4e-15 (k <= 7), tolerance 1e-12
+    # measured agreement 3.4e-15 (k <= 7)
     from scipy.integrate import quad
 
     phi = lambda s: T.eight_kinematics(1.0, 1.0, s)[0][..., 2]  # noqa: E731
@@ -205,9 +207,12 @@ def test_eight_heading_fourier_coefficients_are_the_cosine_integrals():
     for k in range(8):
         ref = quad(lambda s: float(phi(s)) * math.cos(k * s), 0.0, 2 * math.pi, limit=200,
                    epsabs=1e-12, epsrel=0)[0] / (2 * math.pi if k == 0 else math.pi)
-        assert abs(a[k] - ref) < 5e-15, (k, a[k], ref)  # measured 4.8e-16
-    assert a[0] == pytest.approx(math.pi, abs=1e-15)  # measured 0
-    np.testing.assert_allclose(a[2::2], 0.0, rtol=0, atol=1e-15)  # measured 8.2e-17; only odd harmonics
+        # accuracy: quad's epsabs 1e-12 (over pi for k > 0) and the FFT's rounding; measured 4.8e-16
+        assert abs(a[k] - ref) < 1e-12, (k, a[k], ref)
+    # exact: by the symmetry, to the rounding of a 4096-point FFT of values up to 2 pi
+    # (12 stages x 2 pi x eps = 1.7e-14; measured 0 and 8.2e-17); only odd harmonics
+    assert a[0] == pytest.approx(math.pi, abs=2e-14)
+    np.testing.assert_allclose(a[2::2], 0.0, rtol=0, atol=2e-14)  # exact: as above
     assert T.eight_heading_fourier().shape == (10,) and T.eight_heading_fourier(0).shape == (1,)
     with pytest.raises(ValueError, match="n_harmonics must be an integer >= 0"):
         T.eight_heading_fourier(-1)
@@ -217,7 +222,7 @@ def test_eight_heading_fourier_coefficients_are_the_cosine_integrals():
 
 def test_heading_series_sums_its_cosines_and_converges_to_the_heading():
     s = np.linspace(0.0, 2 * math.pi, 9)
-    np.testing.assert_allclose(T.heading_series({0: 1.0, 2: 0.5}, s), 1.0 + 0.5 * np.cos(2 * s), rtol=0, atol=1e-15)  # measured 0
+    np.testing.assert_allclose(T.heading_series({0: 1.0, 2: 0.5}, s), 1.0 + 0.5 * np.cos(2 * s), rtol=0, atol=1e-15)  # exact: a closed form; measured 0
     np.testing.assert_array_equal(T.heading_series({1: 2.0}, [0, 1]), 2.0 * np.cos([0.0, 1.0]))
     a = T.eight_heading_fourier(41)
     series = T.heading_series({k: a[k] for k in range(42)}, s)
@@ -233,7 +238,7 @@ def test_error_dynamics_solution_keeps_the_shape_of_its_times():
     out = control.error_dynamics_solution(Body(), Gains(), e0, de0, t)
     assert out.shape == (2, 3, 3)
     np.testing.assert_allclose(out.reshape(6, 3), control.error_dynamics_solution(Body(), Gains(), e0, de0,
-                                                                                  t.ravel()), rtol=1e-15)  # measured 0
+                                                                                  t.ravel()), rtol=1e-15)  # exact: one code path, two shapes; measured 0
 
 
 # ------------------------------------------------------------------ allocation
@@ -256,8 +261,8 @@ def test_allocation_bound_without_limits_is_the_unlimited_law():
     np.testing.assert_array_equal(beta, beta0)
     F, beta = Allocation("least_squares", (1.0, 1.0, 2.0)).bind(Body())(tau, phi)
     F0, beta0 = A.allocate_least_squares(tau, phi, Body(), (1.0, 1.0, 2.0))
-    np.testing.assert_allclose(F, F0, rtol=1e-15)  # measured 0
-    np.testing.assert_allclose(beta, beta0, rtol=1e-15)  # measured 0
+    np.testing.assert_allclose(F, F0, rtol=1e-15)  # exact: one code path; measured 0
+    np.testing.assert_allclose(beta, beta0, rtol=1e-15)  # exact: one code path; measured 0
     with pytest.raises(TypeError, match=r"^limits must be a lib\.allocation\.Limits, got str$"):
         Allocation().bind(Body(), "none")
 
@@ -318,7 +323,7 @@ def test_least_squares_allocation_broadcasts_one_demand_over_many_headings():
     assert F.shape == beta.shape == (5,)
     for i in range(5):
         Fi, bi = A.allocate_least_squares(tau, phi[i], Body(), (1.0, 1.0, 0.5))
-        assert F[i] == pytest.approx(float(Fi), rel=1e-14, abs=0) and beta[i] == pytest.approx(float(bi), rel=1e-14, abs=0)  # measured 0
+        assert F[i] == pytest.approx(float(Fi), rel=1e-14, abs=0) and beta[i] == pytest.approx(float(bi), rel=1e-14, abs=0)  # exact: one code path; measured 0
     with pytest.raises(TypeError, match=r"^body must be a lib\.params\.Body, got str$"):
         A.allocate_least_squares(tau, 0.0, "body")
 
@@ -342,10 +347,10 @@ def test_closed_loop_uses_its_model_for_the_demand_and_the_allocation():
     z, dz = np.array([1.0, 0.2, 0.3]), np.array([0.1, -0.2, 0.5])
     tau, F, beta = loop.inputs(2.0, z, dz)
     tau_m = control.computed_torque_from(mdl, Gains(), *kin(2.0), z, dz)
-    np.testing.assert_allclose(tau, tau_m, rtol=1e-15, atol=0)  # measured 0: the same call
+    np.testing.assert_allclose(tau, tau_m, rtol=1e-15, atol=0)  # exact: one code path; measured 0: the same call
     F_m, beta_m = law.bind(mdl)(tau_m, z[2])
-    assert F == pytest.approx(float(F_m), rel=1e-15, abs=0)  # measured 0: the same call
-    assert beta == pytest.approx(float(beta_m), rel=1e-15, abs=0)  # measured 0: the same call
+    assert F == pytest.approx(float(F_m), rel=1e-15, abs=0)  # exact: one code path; measured 0: the same call
+    assert beta == pytest.approx(float(beta_m), rel=1e-15, abs=0)  # exact: one code path; measured 0: the same call
     # and the plant's own parameters would give other values
     tau_b = control.computed_torque_from(body, Gains(), *kin(2.0), z, dz)
     assert np.abs(tau_b - tau_m).max() > 1e-2  # reason: a property, the two bodies differ (m 2 vs 3), not an error bound
@@ -532,7 +537,7 @@ def test_arc_minima_finds_the_two_best_local_minima_of_the_arc_even_when_close()
                 if wants is None:
                     wants = np.array([_arc_reference_minima(Gi, ri, f, bmax) for Gi, ri in zip(G, r)])
                 p1, p2 = A._arc_minima(G, r, f, bmax)
-                np.testing.assert_allclose(np.hypot(p1[:, 0], p1[:, 1]), f, rtol=1e-15)  # reason: on the arc by construction, rounding only
+                np.testing.assert_allclose(np.hypot(p1[:, 0], p1[:, 1]), f, rtol=1e-15)  # exact: a point put on the arc by construction; reason: on the arc by construction, rounding only
                 got = np.sort(np.stack([np.arctan2(p1[:, 1], p1[:, 0]), np.arctan2(p2[:, 1], p2[:, 0])], -1), -1)
                 worst = max(worst, np.max(np.abs(got - wants)))
     assert worst < 5e-8, worst   # measured 4.9e-9 (b0 = 0.1, tilt 0.2)

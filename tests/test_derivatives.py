@@ -85,7 +85,7 @@ def test_position_kinematics_of_the_references_is_their_position_and_derivatives
         ref = T.make(kind, 1.7, 0.6)
         kin = T.position_kinematics(ref)
         for t in np.linspace(0.0, 20.0, 41):
-            np.testing.assert_allclose(kin(t), T.POSITIONS[kind](1.7, 0.6, t), rtol=0, atol=1e-14)  # measured 0
+            np.testing.assert_allclose(kin(t), T.POSITIONS[kind](1.7, 0.6, t), rtol=0, atol=1e-14)  # exact: one closed form, two code paths; measured 0
 
 
 class _Wrapped(Reference):
@@ -127,7 +127,7 @@ def test_wrap_angle_keeps_pi_and_sends_minus_pi_to_pi():
     # rounds to pi: the same angle to 4e-16, and inside the interval)
     assert wrap_angle(np.nextafter(np.pi, 0)) == np.nextafter(np.pi, 0)
     w = wrap_angle(np.nextafter(-np.pi, 0))
-    assert -np.pi < w <= np.pi and abs(np.angle(np.exp(1j * (w - np.nextafter(-np.pi, 0))))) < 1e-15  # measured 2.4e-16
+    assert -np.pi < w <= np.pi and abs(np.angle(np.exp(1j * (w - np.nextafter(-np.pi, 0))))) < 1e-15  # exact: a closed form; measured 2.4e-16
 
 
 def test_wrap_angle_of_an_angle_a_hair_above_pi_is_pi_not_minus_pi():
@@ -151,7 +151,7 @@ def test_wrap_angle_lands_in_the_half_open_interval_for_large_multiples():
     # odd multiples of pi land on pi or (after the rounding of k pi) next to -pi, inside the interval
     odd = np.pi * np.array([3, 5, -3, -5, 101, -101])
     w = wrap_angle(odd)
-    assert np.all((w > -np.pi) & (w <= np.pi)) and np.allclose(np.abs(w), np.pi, rtol=0, atol=1e-13)  # measured 1.4e-14
+    assert np.all((w > -np.pi) & (w <= np.pi)) and np.allclose(np.abs(w), np.pi, rtol=0, atol=1e-13)  # exact: a closed form; measured 1.4e-14
 
 
 def test_wrap_angle_keeps_array_shape_and_removes_whole_turns_only():
@@ -159,7 +159,7 @@ def test_wrap_angle_keeps_array_shape_and_removes_whole_turns_only():
     w = wrap_angle(a)
     assert w.shape == a.shape and w.dtype == float
     turns = (a - w) / (2 * np.pi)
-    np.testing.assert_allclose(turns, np.round(turns), rtol=0, atol=1e-14)  # measured 8.9e-16
+    np.testing.assert_allclose(turns, np.round(turns), rtol=0, atol=1e-14)  # exact: a closed form; measured 8.9e-16
     assert np.all((w > -np.pi) & (w <= np.pi))
     assert wrap_angle([[4.0]]).shape == (1, 1)
     assert np.ndim(wrap_angle(4.0)) == 0
@@ -176,9 +176,9 @@ def test_lyapunov_estimate_of_exponential_growth_is_its_rate_in_per_second(a):
     # the rounding of a growing state); tolerance 2e-15, a floor near the rounding
     flow = lambda x, t0, t1: np.asarray(x) * math.exp(a * (t1 - t0))  # noqa: E731
     est = largest_lyapunov(flow, np.zeros(1), 0.5, 20, d0=1e-3)
-    assert abs(est.value - a) < 2e-15, est.value  # measured 1.1e-16
-    assert est.stderr < 2e-15  # measured 2.5e-17
-    np.testing.assert_allclose(est.running, a, rtol=0, atol=2e-15)  # measured 2.2e-16
+    assert abs(est.value - a) < 2e-15, est.value  # exact: a closed-form flow, rounding of 20 logarithms; measured 1.1e-16
+    assert est.stderr < 2e-15  # exact: a closed-form flow, rounding of 20 logarithms; measured 2.5e-17
+    np.testing.assert_allclose(est.running, a, rtol=0, atol=2e-15)  # exact: a closed-form flow, rounding of 20 logarithms; measured 2.2e-16
 
 
 def test_lyapunov_estimate_of_a_linear_system_is_its_largest_eigenvalue():

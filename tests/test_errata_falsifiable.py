@@ -130,3 +130,47 @@ def test_erratum_verdict_flips_with_a_right_printed_and_a_wrong_corrected_form(r
         assert v.printed_holds, f"{row.key}: a right printed form failed its check ({v.detail})"
         assert not v.corrected_holds, f"{row.key}: a wrong corrected form passed its check ({v.detail})"
         assert not v.confirmed
+
+
+# ------------------------------------------------ sub-cases: a form wrong in one case only
+# (issue 28: an errata check that held when one of its cases held, max(|r|) turned into
+# min(|r|), passed every test above, whose wrong forms are wrong as a whole)
+
+def _p0_wrong_for(bad):
+    """p0^(k), right for every k but ``bad``, where it is the printed form."""
+    return lambda k: printed_p0(k) if k == bad else corrected_p0(k)
+
+
+def _p0_off_for(bad):
+    return lambda k: corrected_p0(k) + (sp.Rational(1, 100) if k == bad else 0)
+
+
+def _series_wrong_at(k):
+    return {**CORRECTED_HEADING_SERIES, k: CORRECTED_HEADING_SERIES[k] + 0.01}
+
+
+#: per row key: cases whose printed and corrected forms are both wrong in exactly one sub-case
+SUB_CASES = {
+    "eq33-p0": [dict(printed=_p0_wrong_for(k), corrected=_p0_off_for(k)) for k in (0, 1)],
+    "fourier-a3": [dict(printed=_series_wrong_at(k), corrected=_series_wrong_at(k)) for k in (1, 3, 5)],
+}
+
+
+@pytest.mark.parametrize("key, i", [(key, i) for key, cases in SUB_CASES.items() for i in range(len(cases))])
+def test_erratum_form_wrong_in_one_sub_case_fails_its_check(key, i):
+    row = next(r for r in ROWS if r.key == key)
+    v = row.check(**SUB_CASES[key][i])
+    assert not v.printed_holds, f"{key}: a printed form wrong in one case passed its check ({v.detail})"
+    assert not v.corrected_holds, f"{key}: a corrected form wrong in one case passed its check ({v.detail})"
+
+
+def test_table_number_needs_every_text_reference_to_cite_the_corrected_number():
+    from lib.paper.tracking_errata import PAPER_TABLE_LINES
+
+    row = next(r for r in ROWS if r.key == "table-number")
+    assert row.check().corrected_holds
+    # one more reference, citing another number: the corrected number no longer holds
+    lines = [*PAPER_TABLE_LINES, "as in Tab. 2 above"]
+    assert not row.check(lines=lines).corrected_holds
+    # a second caption: the paper would then have two tables, and "1" is not their count
+    assert not row.check(lines=[*PAPER_TABLE_LINES, "Table 2 Other values"]).corrected_holds

@@ -61,8 +61,11 @@ def test_the_half_period_mirror_squared_is_the_period_map():
     G2 = la.half_period_mirror(BODY, GAINS, EIGHT, b, None,
                                la.half_period_mirror(BODY, GAINS, EIGHT, b, None, S0))
     P = L.switched_runs(BODY, GAINS, EIGHT, b, None, s0=S0, n_periods=1).states[0, 1]
-    # measured 7.9e-14; the run at 45 deg is chaotic and switched, so ~10x headroom
-    assert np.abs(G2[0] - P).max() < 8e-13
+    # accuracy: the same fixed step grid both ways, but the switchings are bracketed to
+    # 1e-11 s (switched_compiled): one placed 1e-11 s apart moves the state by up to 1e-11 s x
+    # the jump of the rates (< 10) per switching, over one period of a chaotic run; 1e-9
+    # (measured 7.9e-14). A wrong mirror moves it by O(1).
+    assert np.abs(G2[0] - P).max() < 1e-9
 
 
 @pytest.mark.parametrize("deg, cap, tol", [
@@ -120,11 +123,11 @@ def test_lyapunov_horizons_reproduce_the_verdicts_exponent():
     b = math.radians(45.0)
     h = la.lyapunov_horizons(BODY, GAINS, EIGHT, [b], None, [48, L.LIMIT_DEFAULTS["periods"]])
     v = L.limit_verdicts(BODY, GAINS, EIGHT, b, None)[0]
-    # measured 0.0 for both (0.198 and 0.0189 1/s): the same chaotic run bit for bit, which no
+    # exact: one code path, the same run bit for bit; measured 0.0 for both (0.198 and 0.0189 1/s): the same chaotic run bit for bit, which no
     # tolerance could stand in for (another run differs by about the standard error); 1e-14
     # relative admits only the block means' summation order over the 120 periods
     assert h.lyapunov.iloc[-1] == pytest.approx(v.lyapunov[0], rel=1e-14, abs=0)
-    # measured 0.0, as above
+    # exact: one code path, the same run bit for bit; measured 0.0, as above
     assert h.stderr.iloc[-1] == pytest.approx(v.lyapunov_stderr[0], rel=1e-14, abs=0)
 
 

@@ -45,7 +45,8 @@ def test_poincare_section_of_periodic_case_has_one_point(perturb):
     loop = L.SwitchedLoop(Body(), Gains(), T.circle(), np.deg2rad(150))
     sec = L.stroboscopic_section(loop, perturb(S0), 15, 5, rtol=1e-10, atol=1e-10)
     assert L.distinct_points(sec, 1e-6) == 1
-    assert np.abs(sec[:, :4]).max() < 7e-13  # measured 6.4e-14
+    # accuracy: 10 x the integration's atol 1e-10 (measured 6.4e-14)
+    assert np.abs(sec[:, :4]).max() < 1e-9
 
 
 def test_distinct_points_counts_a_period_two_orbit():
@@ -75,7 +76,7 @@ def test_beta_never_exceeds_angle_limit(switching):
     bmax = np.deg2rad(30)
     res = simulate(Body(), Gains(), T.eight(), 24.0, limits=Limits(angle=bmax),
                    integration=Integration(rtol=1e-8, atol=1e-8, switching=switching))
-    assert np.all(np.abs(res.beta) <= bmax + 1e-15)  # measured 0 over the limit
+    assert np.all(np.abs(res.beta) <= bmax + 1e-15)  # exact: a clip; measured 0 over the limit
 
 
 @pytest.mark.parametrize("deg,t_end,slides", [(30, 16.0, False), (45, 20.0, True)])
@@ -222,11 +223,11 @@ def test_switched_loop_scalar_fast_path_is_eqs_23_and_2_4(t, s, kind, F, beta):
     s = np.array(s)
     tx, ty, _ = loop._tau(t, s)
     tau = computed_torque(Body(), Gains(), ref, t, s[:3], s[3:])
-    np.testing.assert_allclose([tx, ty], tau[:2], rtol=1e-15, atol=1e-15)  # measured 0
+    np.testing.assert_allclose([tx, ty], tau[:2], rtol=1e-15, atol=1e-15)  # exact: one definition, two code paths; measured 0
     np.testing.assert_allclose(loop._accel(s, F, beta), config_accel(Body(), s[:3], s[3:], F, beta),
-                               rtol=5e-15, atol=5e-15)  # measured 7.6e-16 (1 + |accel|) over 7000 draws
+                               rtol=5e-15, atol=5e-15)  # exact: one closed form, two code paths; measured 7.6e-16 (1 + |accel|) over 7000 draws
     kin = T.position_kinematics(ref)(t)
-    np.testing.assert_allclose(kin[:6], np.r_[ref.z(t)[:2], ref.dz(t)[:2], ref.ddz(t)[:2]], rtol=1e-15, atol=1e-15)  # measured 0
+    np.testing.assert_allclose(kin[:6], np.r_[ref.z(t)[:2], ref.dz(t)[:2], ref.ddz(t)[:2]], rtol=1e-15, atol=1e-15)  # exact: one closed form, two code paths; measured 0
     h = 1e-4
     jerk = (ref.ddz(t + h) - ref.ddz(t - h)) / (2 * h)
     np.testing.assert_allclose(kin[6:], jerk[:2], rtol=1.5e-8, atol=1.5e-8)  # measured 3.5e-9: O(h^2) difference
@@ -365,7 +366,7 @@ def test_compiled_field_is_the_closed_loop_with_its_limits(t, s, kind, bdeg, cap
     switched_compiled._field(P, (bmax, math.cos(bmax), math.sin(bmax), cap), mode, t, s, out, ev)
     lim = Limits(force=None if not np.isfinite(cap) else cap, angle=None if bmax >= math.pi else bmax)
     want = ClosedLoop.of(b, g, reference_of(ref), limits=lim).rates(t, s)[0]
-    np.testing.assert_allclose(out, want, rtol=5e-13, atol=5e-13)  # measured 5.3e-14 (1 + |rates|) over 4000 draws
+    np.testing.assert_allclose(out, want, rtol=5e-13, atol=5e-13)  # exact: one closed form, compiled and numpy, rounding only; measured 5.3e-14 (1 + |rates|) over 4000 draws
 
 
 def test_regime_edges_pair_the_neighbours_across_a_change_of_chaos():
@@ -382,8 +383,11 @@ def test_switched_runs_sample_within_periods_and_reject_bad_sampling():
     ref = T.eight()
     one = L.switched_runs(Body(), Gains(), ref, np.pi, 4.0, n_periods=2)
     many = L.switched_runs(Body(), Gains(), ref, np.pi, 4.0, n_periods=2, samples_per_period=8)
-    assert many.states.shape == (1, 17, 6) and np.allclose(many.t[::8], one.t, rtol=0, atol=1e-14)  # measured 0
-    np.testing.assert_allclose(many.states[0, ::8], one.states[0], rtol=0, atol=7e-14)  # measured 7.3e-15
+    assert many.states.shape == (1, 17, 6) and np.allclose(many.t[::8], one.t, rtol=0, atol=1e-14)  # exact: the same grid of times; measured 0
+    # accuracy: the same fixed steps, but the switchings are bracketed to 1e-11 s
+    # (switched_compiled): a switching placed 1e-11 s apart moves the state by up to
+    # 1e-11 s x the jump of the rates (< 10), over two periods; 1e-9 (measured 7.3e-15)
+    np.testing.assert_allclose(many.states[0, ::8], one.states[0], rtol=0, atol=1e-9)
     with pytest.raises(ValueError, match="samples_per_period"):
         L.switched_runs(Body(), Gains(), ref, 0.5, n_periods=1, samples_per_period=3)
     with pytest.raises(ValueError, match="companion"):

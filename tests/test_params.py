@@ -11,7 +11,7 @@ def test_defaults_are_the_papers_table():
     assert (b.m, b.I, b.a, b.c, b.c_phi) == (2.0, 0.1, 0.4, 0.6, 0.1)
     g = Gains()
     np.testing.assert_array_equal(g.kp, [5.2] * 3)
-    np.testing.assert_allclose(g.kv, [math.sqrt(10.4)] * 3, rtol=0, atol=0)  # measured 0: the same expression
+    np.testing.assert_allclose(g.kv, [math.sqrt(10.4)] * 3, rtol=0, atol=0)  # exact: one expression; measured 0: the same expression
 
 
 @pytest.mark.parametrize("field", ["m", "I", "a", "c", "c_phi"])

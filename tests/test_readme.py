@@ -28,7 +28,7 @@ def test_readme_library_example_runs():
     assert header.split() == ["R", "Theta", "regime", "range", "lost"]
     assert len(rows) == 9 and {r.split()[3] for r in rows} <= {"periodic", "slipping", "chaotic",
                                                                 "quasiperiodic", "undecided"}
-    assert float(last.split()[0]) <= 4.0 + 1e-15          # measured 0 over the cap; F never above the cap
+    assert float(last.split()[0]) <= 4.0 + 1e-15          # exact: a clip; measured 0 over the cap; F never above the cap
 
 
 def test_readme_notebook_route_uses_installed_tools():
@@ -46,3 +46,24 @@ def test_readme_fast_tests_command_deselects_the_slow_markers():
     assert '.venv/bin/python -m pytest -m "not book and not browser"' in README
     pyproject = (ROOT / "pyproject.toml").read_text()
     assert '"book:' in pyproject and '"browser:' in pyproject
+
+
+def test_ci_runs_the_portable_tests_after_make_test_with_the_emulation_the_readme_states():
+    """`.ci/run` runs `make test`, then `make test-portable`; the target sets every variable
+    of the emulation the README's section names (issue 28)."""
+    ci = (ROOT / ".ci" / "run").read_text().split()
+    assert ci.index("test-portable") > ci.index("test")
+    make = (ROOT / "Makefile").read_text()
+    text = _section("Another machine's arithmetic")
+    for var in ("NUMBA_CPU_NAME=generic", "NUMBA_CACHE_DIR=", "OPENBLAS_CORETYPE=Prescott",
+                "NPY_DISABLE_CPU_FEATURES=", "OPENBLAS_NUM_THREADS=1", "NUMBA_NUM_THREADS=1"):
+        assert var in make, var
+    for var in ("NUMBA_CPU_NAME=generic", "NUMBA_CACHE_DIR", "OPENBLAS_CORETYPE=Prescott", "NPY_DISABLE_CPU_FEATURES"):
+        assert var in text, var
+    # the numpy feature names the Makefile disables are ones this numpy dispatches on
+    import numpy as np
+    from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_baseline__
+
+    names = re.search(r'NPY_DISABLE_CPU_FEATURES="([^"]*)"', make).group(1).split()
+    assert names and set(names) <= set(__cpu_dispatch__) - set(__cpu_baseline__), (names, __cpu_dispatch__)
+    assert np.__version__

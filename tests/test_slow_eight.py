@@ -46,10 +46,10 @@ def test_frozen_heading_is_the_circles_stable_equilibrium_on_the_osculating_circ
     for si, sg, kp, pi, ki in zip(s, sig, kap, p, k):
         R_loc, th_loc = R / abs(kp), Theta * sg * abs(kp)   # radius (m), rate v / R_loc (rad/s)
         p_circle = circle_equilibria(BODY, R_loc, th_loc)[0]
-        # the same closed form by two routes: measured 3.3e-16 rad at most (p* of 0.27-0.78)
+        # exact: one closed form, two routes; the same closed form by two routes: measured 3.3e-16 rad at most (p* of 0.27-0.78)
         assert pi == pytest.approx(math.copysign(1.0, kp) * p_circle, rel=0, abs=3e-15), si
         r_crit = BODY.c_phi / (BODY.a * math.hypot(BODY.m * th_loc, BODY.c))
-        assert ki == pytest.approx(r_crit / R_loc, rel=2e-15, abs=0)   # measured 2.2e-16 relative
+        assert ki == pytest.approx(r_crit / R_loc, rel=2e-15, abs=0)   # exact: one closed form, two routes; measured 2.2e-16 relative
 
 
 def test_frozen_heading_is_absent_where_the_osculating_circle_is_below_its_critical_radius():
@@ -73,9 +73,9 @@ def test_follows_exactly_when_the_frozen_equilibrium_exists_along_the_path():
     r = float(follow_radius(BODY, Theta))
     pr = slow_eight_prediction(BODY, [0.98 * r, 1.02 * r], Theta)
     assert list(pr.follows) == [False, True]
-    assert pr.k_max == pytest.approx([1 / 0.98, 1 / 1.02], rel=1e-15, abs=0)   # measured 0.0 (rounding floor)
+    assert pr.k_max == pytest.approx([1 / 0.98, 1 / 1.02], rel=1e-15, abs=0)   # exact: a ratio of two closed forms; measured 0.0 (rounding floor)
     assert np.isnan(pr.frozen_range[0]) and pr.frozen_range[1] > 0
-    # measured 0.0: the range is max - min (rounding floor)
+    # exact: max - min; measured 0.0: the range is max - min (rounding floor)
     assert pr.frozen_range[1] == pytest.approx(pr.frozen_max[1] - pr.frozen_min[1], rel=1e-15, abs=0)
 
 
@@ -152,10 +152,10 @@ def test_prediction_is_vectorised_over_a_grid():
     assert g.corrected_range.shape == (2, 2) and g.r_follow.shape == (2, 2)
     one = slow_eight_prediction(BODY, 2.0, 0.2)
     assert one.corrected_range.shape == ()
-    # measured 0.0 for both: the same closed form, and (corrected) the same 512 RK4 steps and
+    # exact: one code path, a grid and one point; measured 0.0 for both: the same closed form, and (corrected) the same 512 RK4 steps and
     # Illinois iterates; 1e-14 for the second admits the libm's last bits over those steps
     assert g.frozen_range[1, 1] == pytest.approx(float(one.frozen_range), rel=1e-15, abs=0)
-    # measured 0.0 (see above)
+    # exact: one code path, a grid and one point; measured 0.0 (see above)
     assert g.corrected_range[1, 1] == pytest.approx(float(one.corrected_range), rel=1e-14, abs=0)
 
 

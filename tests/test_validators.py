@@ -206,7 +206,7 @@ def test_least_squares_kernel_solves_singular_rows_and_leaves_a_blown_up_row_alo
     assert np.all(np.isnan(u[2])) and np.all(np.isfinite(u[:2]))
     a = body.a
     np.testing.assert_allclose(u[1], [0.0, (2.0 + 0.5 * a * 0.3) / (1 + 0.5 * a * a)], rtol=0,
-                               atol=1e-15)                               # measured 0
+                               atol=1e-15)                               # exact: a closed form; measured 0
     one, *_ = A._ls_kernel(tau[0], phi[0], body, np.sqrt(w))            # the regular row as alone
     np.testing.assert_array_equal(u[0], one)
 

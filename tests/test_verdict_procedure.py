@@ -14,6 +14,7 @@ from lib import stability
 from lib.angles import wrap_angle
 from lib.rotation.circle import circle_critical_radius, circle_eigenvalues
 from lib.dynamics import verdicts as dv
+from lib.dynamics.orbits import newton_orbit
 from lib.params import Body
 from lib.rotation.engine import RotationMap, _Engine
 from lib.rotation.field import coefficients
@@ -96,8 +97,8 @@ def test_block_statistics_are_the_mean_and_error_of_the_block_means():
     mean, se = dv.block_statistics(v, 12)
     for i in range(3):
         means = [v[i, 2 + 12 * b: 2 + 12 * (b + 1)].mean() for b in range(4)]
-        assert mean[i] == pytest.approx(np.mean(means), rel=1e-14, abs=0)  # measured 0
-        assert se[i] == pytest.approx(np.std(means, ddof=1) / 2.0, rel=1e-14, abs=0)  # measured 0
+        assert mean[i] == pytest.approx(np.mean(means), rel=1e-14, abs=0)  # exact: one formula on given numbers; measured 0
+        assert se[i] == pytest.approx(np.std(means, ddof=1) / 2.0, rel=1e-14, abs=0)  # exact: one formula on given numbers; measured 0
     with pytest.raises(ValueError, match="two blocks"):
         dv.block_statistics(v[:, :20], 12)
 
@@ -106,7 +107,7 @@ def test_drift_of_a_steady_slip_is_its_rate_with_zero_error():
     # a heading gaining 0.25 turns per period, sampled at the ends of blocks of 6 periods
     ends = 2 * np.pi * 0.25 * 6 * np.arange(9.0)
     drift, se = dv.drift_statistics(ends[None], 6, 2 * np.pi)
-    assert drift[0] == pytest.approx(0.25, rel=1e-14, abs=0) and se[0] == pytest.approx(0.0, abs=1e-14)  # measured 0 and 2.6e-17
+    assert drift[0] == pytest.approx(0.25, rel=1e-14, abs=0) and se[0] == pytest.approx(0.0, abs=1e-14)  # exact: one formula on given numbers; measured 0 and 2.6e-17
 
 
 # ---------------------------------------------------------------- orbits
@@ -125,7 +126,7 @@ def test_lag_candidates_find_the_period_and_its_turns(turns):
     ok, n, defect = dv.lag_candidates(_two_cycle(17, turns), 8, 1e-9, turn_axis=0)
     assert ok[:, 0].tolist() == [False, True, False, True, False, True, False, True]
     assert n[1, 0] == 2 * turns
-    assert defect[0, 0] == pytest.approx(0.6, abs=1e-15)  # measured 0
+    assert defect[0, 0] == pytest.approx(0.6, abs=1e-15)  # exact: a difference of given numbers; measured 0
     blocked, _, _ = dv.lag_candidates(_two_cycle(17, turns), 8, 1e-9, turn_axis=0, turns=False)
     assert blocked[1, 0] == (turns == 0)
 
@@ -160,8 +161,10 @@ def test_newton_finds_the_fixed_point_of_a_contraction_and_its_turns():
 
     r = dv.newton(step, np.arange(2), np.array([[0.4, 0.2], [-0.3, -0.1]]), 1, turn_axis=0, tol=1e-13,
                   max_iter=30)
-    assert np.all(r.residual <= 1e-13)  # reason: the stopping tolerance given to newton above
-    assert np.allclose(r.x, 0.0, rtol=0, atol=1e-14) and r.turns.tolist() == [1, 1]  # measured 6.0e-16
+    assert np.all(r.residual <= 1e-13)  # exact: the stopping rule itself; reason: the stopping tolerance given to newton above
+    # accuracy: residual <= tol = 1e-13 times |(J - I)^-1| at 0 (J - I = [[0.5, 0.1], [0, -0.5]]:
+    # 2.2), 2.2e-13: the floor (measured 6.0e-16)
+    assert np.allclose(r.x, 0.0, rtol=0, atol=1e-12) and r.turns.tolist() == [1, 1]
     assert np.all(r.iterations >= 2)
 
 
@@ -185,7 +188,9 @@ def test_the_circles_equilibrium_has_the_exponent_of_the_linearisation_34():
     frame = rotation_verdicts.rotation_verdicts(BODY, "circle", [R], [theta])
     assert frame.regime[0] == "periodic" and frame.period[0] == 1
     expected = circle_eigenvalues(BODY, R, theta).real.max()
-    assert frame.lyapunov[0] == pytest.approx(expected, rel=1e-13)  # measured 0
+    # accuracy: the verdict's multiplier comes from 128 steps of the 8th-order scheme a
+    # period, whose error lies below the floor (measured 0)
+    assert frame.lyapunov[0] == pytest.approx(expected, rel=1e-12)
 
 
 def test_undecided_rows_are_decided_again_and_keep_their_place():
@@ -241,14 +246,14 @@ def test_drift_and_its_error_are_those_of_the_block_increments():
     # standard error std(ddof = 1) / sqrt(4) = 1.2910 / 2 / 4; a second row standing still
     ends = np.array([[0.0, 1.0, 3.0, 6.0, 10.0], [7.0] * 5])
     drift, se = dv.drift_statistics(ends, periods_per_block=2.0, unit=2.0)
-    np.testing.assert_allclose(drift, [2.5 / 4, 0.0], rtol=1e-15, atol=0)  # measured 0
-    np.testing.assert_allclose(se, [np.std([1, 2, 3, 4], ddof=1) / 2 / 4, 0.0], rtol=1e-15, atol=0)  # measured 0
+    np.testing.assert_allclose(drift, [2.5 / 4, 0.0], rtol=1e-15, atol=0)  # exact: one formula on given numbers; measured 0
+    np.testing.assert_allclose(se, [np.std([1, 2, 3, 4], ddof=1) / 2 / 4, 0.0], rtol=1e-15, atol=0)  # exact: one formula on given numbers; measured 0
 
 
 def test_block_statistics_need_two_blocks_and_take_the_last_complete_ones():
     # 5 periods in blocks of 2: the last 4 form 2 blocks (means 2.5 and 4.5), the first is dropped
     mean, se = dv.block_statistics(np.array([[100.0, 2.0, 3.0, 4.0, 5.0]]), 2)
-    assert mean[0] == 3.5 and se[0] == pytest.approx(np.std([2.5, 4.5], ddof=1) / np.sqrt(2), rel=1e-15)  # measured 0
+    assert mean[0] == 3.5 and se[0] == pytest.approx(np.std([2.5, 4.5], ddof=1) / np.sqrt(2), rel=1e-15)  # exact: one formula on given numbers; measured 0
     with pytest.raises(ValueError, match="two blocks"):
         dv.block_statistics(np.ones((1, 3)), 2)
 
@@ -308,7 +313,9 @@ def test_enclosed_orbit_finds_an_attracting_or_repelling_fixed_point_inside_a_cu
     attracting, mu = dv.enclosed_orbit(step, np.array([0, 1]), sec, turn_axis=0, newton_tol=1e-12,
                                        newton_options=dict(max_iter=10))
     assert attracting.tolist() == [True, False]
-    np.testing.assert_allclose(mu, gains, rtol=1e-13)  # measured 0
+    # accuracy: the eigensolver's backward error, a few eps |A|, on a scaled rotation (normal:
+    # condition 1): the floor (measured 0)
+    np.testing.assert_allclose(mu, gains, rtol=1e-12)
 
 
 # ---------------------------------------------------------------- find_orbits and its steps on a toy period map
@@ -403,15 +410,15 @@ def test_find_orbits_reports_the_orbits_runs_reach_with_their_period_turns_and_m
     assert out["k"].tolist() == [1, 1, 2, 1, 0, 0] and out["lag"].tolist() == [1, 1, 2, 2, 0, 0]
     assert out["n"].tolist() == [0, 1, 0, 1, 0, 0]
     assert all(out[f].dtype.kind == "i" for f in ("k", "lag", "n"))
-    # rho: the largest |multiplier| of P^k for the least period k, |mu_1(P^lag)|^(k / lag)
+    # exact: diagonal Jacobians, products of two numbers; rho: the largest |multiplier| of P^k for the least period k, |mu_1(P^lag)|^(k / lag)
     np.testing.assert_allclose(out["rho"][:4], [0.5, 0.5, 0.36, 0.9], rtol=1e-15, atol=0)  # measured 0
-    np.testing.assert_allclose(out["floquet"][:5], [0.5, 0.5, 0.36, 0.81, 0.5], rtol=1e-15, atol=0)  # measured 0
+    np.testing.assert_allclose(out["floquet"][:5], [0.5, 0.5, 0.36, 0.81, 0.5], rtol=1e-15, atol=0)  # exact: diagonal Jacobians, products of two numbers; measured 0
     np.testing.assert_allclose(np.abs(out["mult"][:4]), [[0.5, 0.25], [0.5, 0.25], [0.36, 0.25], [0.81, 0.25]],
-                               rtol=1e-15, atol=0)  # measured 0
+                               rtol=1e-15, atol=0)  # exact: diagonal Jacobians, products of two numbers; measured 0
     # the orbit point Newton found from the last state (the 2-cycle's point near it: +0.3)
-    np.testing.assert_allclose(out["x"][:4, 0], [0, 0, 0.3, 0], rtol=0, atol=1e-16)  # measured 1.1e-18
+    np.testing.assert_allclose(out["x"][:4, 0], [0, 0, 0.3, 0], rtol=0, atol=1e-16)  # exact: a linear map, Newton's step lands on the point to rounding; measured 1.1e-18
     np.testing.assert_allclose(wrap_angle(out["x"][:4, 1] - [0.3, 0.3, -0.4, 0.3]), 0, rtol=0,
-                               atol=3e-13)  # measured 2.5e-14 (a heading 24 pi out)
+                               atol=3e-13)  # exact: a linear map, to the rounding of a heading 24 pi out; measured 2.5e-14
     assert np.all(out["residual"][:4] <= 1e-12)   # reason: Newton's stopping tolerance (OPTS)
     # the distance of the last state to the orbit (the heading modulo whole turns), and the
     # orbit point it is nearest to
@@ -420,9 +427,9 @@ def test_find_orbits_reports_the_orbits_runs_reach_with_their_period_turns_and_m
     dd[:, 1] = wrap_angle(dd[:, 1])
     np.testing.assert_allclose(out["distance"][:4], np.abs(dd).max(axis=1), rtol=1e-8, atol=0)  # measured 1.5e-9
     assert out["distance"][3] > 1e-3              # reason: the alternating run is still 1.8e-3 away (0.9^12)
-    np.testing.assert_allclose(out["near"][:4, 0], orbit[:, 0], rtol=0, atol=1e-16)  # measured 9.8e-19
+    np.testing.assert_allclose(out["near"][:4, 0], orbit[:, 0], rtol=0, atol=1e-16)  # exact: a given orbit point; measured 9.8e-19
     np.testing.assert_allclose(wrap_angle(out["near"][:4, 1] - orbit[:, 1]), 0, rtol=0,
-                               atol=4e-14)  # measured 3.6e-15
+                               atol=4e-14)  # exact: a given orbit point, to the rounding of the heading; measured 3.6e-15
     # rows without an orbit: every orbit field NaN, nothing left over from an attempt
     for f in ("rho", "x", "mult", "residual", "distance", "near"):
         assert np.isnan(out[f][4:]).all(), f
@@ -440,7 +447,7 @@ def test_find_orbits_says_why_an_orbit_does_not_count_and_goes_on_to_longer_peri
     assert out["status"].tolist() == ["not attracting", "found", "not converged", "not attracting"]
     assert out["found"].tolist() == [False, True, False, False] and out["k"][1] == 2
     # floquet: the last attempt's, lag 4 for the repelling point (tried at every lag)
-    np.testing.assert_allclose(out["floquet"][[0, 3]], [1.5 ** 4, 1.0], rtol=1e-15, atol=0)  # measured 0
+    np.testing.assert_allclose(out["floquet"][[0, 3]], [1.5 ** 4, 1.0], rtol=1e-15, atol=0)  # exact: diagonal Jacobians, products of numbers; measured 0
     assert np.isnan(out["floquet"][2])
 
 
@@ -545,7 +552,7 @@ def test_find_orbits_waits_on_the_multiples_of_an_orbit_not_yet_reached():
     tried = np.full((4, 1), np.inf)
     out = _find(pm, runs, tried=tried)
     assert out["status"].tolist() == ["not reached"]
-    np.testing.assert_allclose(out["floquet"], [0.36], rtol=1e-15, atol=0)  # measured 0
+    np.testing.assert_allclose(out["floquet"], [0.36], rtol=1e-15, atol=0)  # exact: a diagonal Jacobian, a product of two numbers; measured 0
     assert tried[:, 0].tolist() == [np.inf, 0.0, np.inf, np.inf]
 
 
@@ -589,10 +596,10 @@ def test_distance_to_orbit_wraps_only_the_heading_and_only_where_turns_allow():
     pts = np.array([[[0.0, 0.5], [5.0, 0.0]], [[1.0, 0.0], [5.0, 1.0]], [[np.nan, np.nan], [0.5, 0.0]]])
     state = np.array([[1.0, TWO_PI + 0.125], [0.25, 0.0]])
     d, j = dv.distance_to_orbit(state, pts, turn_axis=1)                  # turns allowed by default
-    np.testing.assert_allclose(d, [0.125, 0.25], rtol=1e-15, atol=0)  # measured 0 (2 pi + 0.125 wrapped)
+    np.testing.assert_allclose(d, [0.125, 0.25], rtol=1e-15, atol=0)  # exact: a difference of given numbers; measured 0 (2 pi + 0.125 wrapped)
     assert j.tolist() == [1, 2]
     d, j = dv.distance_to_orbit(state, pts, turn_axis=1, turns=[False, True])
-    np.testing.assert_allclose(d, [TWO_PI - 0.375, 0.25], rtol=1e-15, atol=0)  # measured 0
+    np.testing.assert_allclose(d, [TWO_PI - 0.375, 0.25], rtol=1e-15, atol=0)  # exact: a difference of given numbers; measured 0
     assert j.tolist() == [0, 2]
 
 
@@ -617,7 +624,7 @@ def test_orbit_points_stop_at_each_rows_period():
     assert pts.shape == (2, 2, 2)
     np.testing.assert_array_equal(pts[0], [[1.5, 0.0], [1.5, TWO_PI]])
     assert np.isnan(pts[1, 0]).all()
-    np.testing.assert_allclose(pts[1, 1], [0.75, 2 * TWO_PI], rtol=1e-15, atol=0)  # measured 0
+    np.testing.assert_allclose(pts[1, 1], [0.75, 2 * TWO_PI], rtol=1e-15, atol=0)  # exact: given numbers; measured 0
 
 
 def test_section_returns_of_a_standing_run_a_short_one_and_a_one_dimensional_one():
@@ -656,7 +663,7 @@ def test_section_returns_are_per_run_invariant_under_scale_and_heading_shift():
     assert dv.section_returns(4 * line, angles=())[0] == dv.section_returns(line, angles=())[0]
     for c in (1.0, np.pi / 2, -2.0, 3.0):
         np.testing.assert_allclose(dv.section_returns(line + [c, 0.0])[0], alone[0], rtol=1e-15,
-                                   atol=0)  # measured 0
+                                   atol=0)  # exact: one code path, shifted by whole turns; measured 0
     # whole numbers are states too: a heading advancing 1 rad a period, given as integers
     ints = np.stack([np.arange(40), np.zeros(40, int)], axis=-1)[:, None]
     assert dv.section_returns(ints).tolist() == dv.section_returns(ints * 1.0).tolist()
@@ -680,7 +687,7 @@ def test_enclosed_orbit_starts_newton_at_the_circular_mean_of_each_curve():
     att, mu = dv.enclosed_orbit(pm.step, np.arange(2), sec, turn_axis=1, newton_tol=1e-12,
                                 newton_options=dict(max_iter=0))
     assert att.tolist() == [True, True]
-    np.testing.assert_allclose(mu, [0.5, 0.8], rtol=1e-15, atol=0)  # measured 0
+    np.testing.assert_allclose(mu, [0.5, 0.8], rtol=1e-15, atol=0)  # exact: diagonal Jacobians; measured 0
     # a neutral heading (a = 1), x symmetric about its fixed point: the residual is 0 = tol
     # exactly; |mu_1| = 1 is not attracting
     pm = ToyMap(a=1.0)
@@ -751,3 +758,108 @@ def test_section_returns_judge_the_state_at_a_third_of_the_run_too():
     r = dv.section_returns(sec, angles=())
     assert r[0] > 0.2            # measured 0.223: about (1.6 - 1) / 2.6, the outlier's gap over D
     assert dv.section_returns(np.delete(sec, L // 3, axis=0), angles=())[0] < 0.05  # measured 0.021 without it
+
+
+# ------------------------------------------- bug classes: chains of divisors, complex multipliers
+# (issue 28: a least period trying its divisors in ascending order, and stability judged by
+# the real part of a multiplier, both passed the suite)
+
+def _images(x, period, lag, slip=(0.0, 0.0)):
+    """pts (lag, 1, 2) of a point of least period ``period``: P^j(x) = x + (j / period) slip
+    where period divides j, and 0.1 away (in x) elsewhere."""
+    pts = np.empty((lag, 1, 2))
+    for j in range(1, lag + 1):
+        pts[j - 1, 0] = x[0] + (np.array(slip) * j / period if j % period == 0 else [0.1, 0.0])
+    return pts
+
+
+@pytest.mark.parametrize("lag, period", [(4, 1), (4, 2), (6, 1), (6, 2), (6, 3), (8, 1), (8, 2), (8, 4),
+                                         (6, 6), (8, 8)])
+def test_least_period_is_the_smallest_divisor_along_a_chain_of_divisors(lag, period):
+    # lag 8 of a period-2 orbit: its divisors 2 and 4 both return, 1 does not; the least
+    # period is 2 (trying the divisors in the other order would report 4)
+    x = np.array([[0.5, 0.2]])
+    pts = _images(x, period, lag)
+    k, n = dv.least_period(x, pts, np.array([lag]), np.array([0]), turn_axis=1, tol=1e-9)
+    assert (k[0], n[0]) == (period, 0)
+    # slipping: one turn of the heading per period, so lag / period turns at the lag
+    pts = _images(x, period, lag, slip=(0.0, TWO_PI))
+    k, n = dv.least_period(x, pts, np.array([lag]), np.array([lag // period]), turn_axis=1, tol=1e-9)
+    assert (k[0], n[0]) == (period, 1)
+    k, n = dv.least_period(x, pts, np.array([lag]), np.array([lag // period]), turn_axis=1, turns=False,
+                           tol=1e-9)
+    assert (k[0], n[0]) == ((lag, lag // period) if period < lag else (period, 1))
+
+
+def test_least_period_of_several_rows_takes_each_rows_own_divisors():
+    # rows of lags 4, 6, 8 and 8 at once (NaN past a row's own lag), least periods 1, 3, 2, 8
+    x = np.array([[0.5, 0.2], [0.1, -1.0], [2.0, 0.0], [0.0, 3.0]])
+    rows = [(4, 1), (6, 3), (8, 2), (8, 8)]
+    pts = np.full((8, 4, 2), np.nan)
+    for i, (lag, period) in enumerate(rows):
+        pts[:lag, i] = _images(x[i:i + 1], period, lag)[:, 0]
+    k, _ = dv.least_period(x, pts, np.array([4, 6, 8, 8]), np.zeros(4, int), turn_axis=1, tol=1e-9)
+    assert k.tolist() == [1, 3, 2, 8]
+
+
+class FocusMap:
+    """P(x) = c + r R(theta) (x - c), R a rotation: a focus at c with the complex multipliers
+    r exp(+-i theta), one (r, theta) per row; column 1 the heading (``turn_axis`` 1)."""
+
+    turn_axis = 1
+
+    def __init__(self, r, theta, c=(0.0, 0.3)):
+        self.r, self.theta, self.c = np.atleast_1d(r), np.atleast_1d(theta), np.asarray(c, dtype=float)
+
+    def step(self, idx, X, k):
+        idx = np.asarray(idx)
+        k = np.broadcast_to(np.asarray(k, dtype=int), (len(idx),))
+        a, s = self.r[idx] ** k, self.theta[idx] * k
+        A = a[:, None, None] * np.stack([np.stack([np.cos(s), -np.sin(s)], -1),
+                                         np.stack([np.sin(s), np.cos(s)], -1)], -2)
+        return self.c + np.einsum("mij,mj->mi", A, np.asarray(X, dtype=float) - self.c), A
+
+    def advance(self, idx, X, k):
+        return self.step(idx, X, k)[0]
+
+    def run(self, x0, L):
+        out = [np.array(x0, dtype=float)]
+        for _ in range(L - 1):
+            out.append(self.advance(np.arange(len(out[0])), out[-1], 1))
+        return np.stack(out)
+
+
+@pytest.mark.parametrize("r, found", [(0.98, True), (0.995, True), (1.005, False), (1.02, False)])
+@pytest.mark.parametrize("theta", [1.3, math.pi / 2, 2.9])
+def test_a_focus_is_attracting_by_the_modulus_of_its_complex_multipliers(r, found, theta):
+    # |mu| = r just below or above 1, mu complex: |Re mu| = r |cos theta| < 1 every time, so a
+    # stability judged by the real part would take the repelling focus as attracting
+    pm = FocusMap([r], [theta])
+    out = _find(pm, _standing(pm.c, 13))
+    assert out["status"].tolist() == ["found" if found else "not attracting"]
+    assert out["found"].tolist() == [found] and out["k"].tolist() == [1 if found else 0]
+    # the last attempt's |mu|: lag 1 for the attracting focus, lag 4 (max_period) for the
+    # repelling one, tried at every lag
+    want = r if found else r ** OPTS["max_period"]
+    assert out["floquet"][0] == pytest.approx(want, rel=1e-12)  # accuracy: the eigensolver on a normal matrix: the floor
+    # and an orbit's own verdict (lib.dynamics.orbits.Orbit.attracting)
+    orb = newton_orbit(lambda x: pm.step(np.zeros(len(x), int), x, 1), pm.c + [[1e-3, -2e-3]], 1)
+    assert orb.converged[0] and orb.attracting[0] == (r < 1)
+    mu = orb.multipliers[0]
+    assert abs(mu[0].imag) > 0.1 and abs(mu[0].real) < 1  # reason: the case that tells |mu| from |Re mu|
+
+
+def test_a_focus_returning_at_lag_four_but_not_at_lag_one_is_a_fixed_point():
+    # a quarter turn a period, slowly contracting: the run returns near itself at lag 4 (the
+    # lag-4 defect 6e-4 is within candidate_tol 1e-3), not at lags 1-3 (1e-2 and more).
+    # Newton on P^4 lands on the focus, whose P^1 and P^2 both return it: least period 1
+    pm = FocusMap([0.98], [math.pi / 2])
+    runs = pm.run([pm.c + [0.01, 0.0]], 13)
+    cand, _, defect = dv.lag_candidates(runs, 4, OPTS["candidate_tol"], turn_axis=1, ends=2)
+    assert cand[:, 0].tolist() == [False, False, False, True]
+    out = _find(pm, runs)
+    assert out["status"].tolist() == ["found"]
+    assert (out["k"][0], out["lag"][0], out["n"][0]) == (1, 4, 0)
+    # rho is the least period's: |mu(P^4)|^(1/4) = 0.98
+    assert out["rho"][0] == pytest.approx(0.98, rel=1e-12)  # accuracy: the eigensolver on a normal matrix: the floor
+    np.testing.assert_allclose(out["x"][0], pm.c, rtol=0, atol=1e-12)  # accuracy: Newton on a linear map, newton_tol 1e-12

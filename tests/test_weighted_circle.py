@@ -40,8 +40,8 @@ def _flow(w_phi, y0, t_end, t_eval=None, tol=1e-12):
 @pytest.mark.parametrize("R_, theta", [(2.0, math.pi / 4), (0.7, 1.3), (3.5, 0.3)])
 def test_with_no_heading_weight_the_steady_state_is_chapter_5s_equilibrium(R_, theta):
     st = circle_steady_state(BODY, GAINS, R_, theta, (1.0, 1.0, 0.0))
-    assert abs(st.heading - circle_equilibria(BODY, R_, theta)[0]) < 1e-13  # measured 0
-    assert abs(st.radial) < 1e-13 and abs(st.tangential) < 1e-13  # measured 0
+    assert abs(st.heading - circle_equilibria(BODY, R_, theta)[0]) < 1e-13  # exact: w_phi = 0 starts the continuation on Chapter 5's closed form, and Newton is not run; measured 0
+    assert abs(st.radial) < 1e-13 and abs(st.tangential) < 1e-13  # exact: w_phi = 0 starts the continuation on Chapter 5's closed form, and Newton is not run; measured 0
     # the spectrum: (34)'s pair and the four roots of (24), m s^2 + kv s + kp, seen from the
     # frame rotating at theta (shifted by +-i theta)
     s24 = np.roots([BODY.m, GAINS.kv[0], GAINS.kp[0]])
@@ -78,16 +78,59 @@ def test_eigenvalues_match_a_linearisation_by_simulating_perturbations(w_phi):
 def test_steady_state_is_an_equilibrium_of_the_simulated_loop():
     st = circle_steady_state(BODY, GAINS, R, THETA, (1.0, 1.0, 1.0))
     y = _flow(1.0, st.state, 20.0)[-1]
-    assert np.max(np.abs(y - st.state)) < 3e-13  # measured 3.1e-14
+    # accuracy: 100 x the simulation's rtol = atol = 1e-12 over 20 s, plus the steady state's
+    # Newton residual 1e-13 times |J^-1| = 19: 1e-10 (measured 3.1e-14)
+    assert np.max(np.abs(y - st.state)) < 1e-10
 
 
 def test_limit_is_a_hopf_point_just_before_the_fold(limit):
     assert limit.kind in LIMIT_KINDS
     assert limit.kind == "complex pair" and 2.0 < limit.w_phi < 4.0
-    assert abs(limit.eigenvalue.real) < 1e-10 and abs(limit.eigenvalue.imag) > 0.05  # measured 7.8e-12; reason: Im > 0.05 is a property (measured 0.19)
+    # accuracy: brentq brackets log w_phi to xtol = rtol / 4 = 2.5e-7, and there Re lambda
+    # changes by 1.05 per unit of log w_phi (measured), so |Re lambda| <= 2.6e-7; 1e-6 bounds it
+    # on any machine (measured 7.8e-12 here, 3.5e-10 on another);
+    # reason: Im > 0.05 is a property (measured 0.19)
+    assert abs(limit.eigenvalue.real) < 1e-6 and abs(limit.eigenvalue.imag) > 0.05
+    # the crossing itself: 40 x xtol either side, the largest real part changes sign
     below = circle_steady_state(BODY, GAINS, R, THETA, (1.0, 1.0, limit.w_phi * (1 - 1e-5)))
     above = circle_steady_state(BODY, GAINS, R, THETA, (1.0, 1.0, limit.w_phi * (1 + 1e-5)))
     assert below.max_real < 0 < above.max_real
+
+
+def _max_real_by_another_jacobian(w_phi, h=1e-4):
+    """The largest real part of the eigenvalues at the steady state for w_phi, from a
+    Jacobian with 100 times the library's difference step, unsorted: no eigenvalue order."""
+    st = circle_steady_state(BODY, GAINS, R, THETA, (1.0, 1.0, w_phi))
+    lam = np.linalg.eigvals(_jacobian(_loop(BODY, GAINS, R, THETA, (1.0, 1.0, w_phi)), THETA, st.state, h=h))
+    return lam[np.argmax(lam.real)]
+
+
+def test_limit_and_its_eigenvalues_agree_with_an_independent_root_of_the_largest_real_part(limit):
+    # Chapter 6's exact limit, on every machine: the root of max Re lambda(w_phi) found again by
+    # brentq (xtol 1e-9 in log w_phi) on eigenvalues taken from another Jacobian (step 1e-4, not
+    # 1e-6; its error moves the root by about 1e-8) with no sorting of the eigenvalues. A sort by
+    # modulus instead of by real part would put the limit at 3.185, "fold" (issue 28).
+    from scipy.optimize import brentq
+
+    w = limit.w_phi
+    logw = brentq(lambda x: _max_real_by_another_jacobian(math.exp(x)).real,
+                  math.log(w) - 1e-4, math.log(w) + 1e-4, xtol=1e-9)
+    # accuracy: the limit's own rtol (1e-6) plus the independent root's (1e-9) and its
+    # Jacobian's shift (1e-8): 2 x rtol (measured 8.8e-10)
+    assert limit.w_phi == pytest.approx(math.exp(logw), rel=2 * limit.rtol, abs=0)
+    assert round(limit.w_phi, 3) == 3.130 and limit.kind == "complex pair"   # Chapter 6's value
+    # the critical eigenvalue: Im lambda moves by |dIm/dlog w| (< 1) times the roots' distance
+    # (< 2e-6) plus the two Jacobians' difference (measured 4.3e-9); accuracy: 1e-5
+    lam = _max_real_by_another_jacobian(w)
+    assert abs(limit.eigenvalue.imag) == pytest.approx(abs(lam.imag), abs=1e-5)  # accuracy: as above
+    assert abs(lam.real) < 1e-5 and limit.eigenvalue == limit.steady.eigenvalues[0]  # accuracy: as above
+    # and the whole spectrum at the limit, eigenvalue by eigenvalue (accuracy: the two
+    # Jacobians differ by 1e-8 relative in the entries; measured 4.3e-9)
+    other = np.linalg.eigvals(_jacobian(_loop(BODY, GAINS, R, THETA, (1.0, 1.0, w)), THETA, limit.steady.state, h=1e-4))
+    for m in limit.steady.eigenvalues:
+        assert np.min(np.abs(other - m)) < 1e-6  # accuracy: as above
+    # sorted by decreasing real part, the critical pair first
+    assert np.all(np.diff(limit.steady.eigenvalues.real) <= 0)
 
 
 def test_simulation_decays_below_the_limit_and_leaves_above(limit):
@@ -115,7 +158,9 @@ def test_simulation_decays_below_the_limit_and_leaves_above(limit):
 def test_steady_state_does_not_depend_on_the_time_of_the_frame(w_phi):
     st = [circle_steady_state(BODY, GAINS, R, THETA, (1.0, 1.0, w_phi), t=t) for t in (0.0, 1.7, 123.4)]
     for s in st[1:]:
-        assert np.max(np.abs(s.state - st[0].state)) < 1e-13  # measured 8.9e-15
+        # accuracy: each is Newton's, polished to a residual of 1e-13 (_solve), times |J^-1|
+        # (19 at the limit): 1e-11 (measured 8.9e-15)
+        assert np.max(np.abs(s.state - st[0].state)) < 1e-11
         assert np.max(np.abs(s.eigenvalues - st[0].eigenvalues)) < 2.5e-7  # measured 2.3e-8
     rng = np.random.default_rng(3)
     y = st[0].state + rng.normal(scale=0.3, size=(20, 6))
@@ -126,7 +171,7 @@ def test_steady_state_does_not_depend_on_the_time_of_the_frame(w_phi):
 def test_the_frames_are_inverse():
     rng = np.random.default_rng(0)
     y = rng.normal(size=(10, 6))
-    assert np.allclose(inertial_to_rotating(rotating_to_inertial(y, THETA, 3.3), THETA, 3.3), y, rtol=0, atol=5e-15)  # measured 4.4e-16
+    assert np.allclose(inertial_to_rotating(rotating_to_inertial(y, THETA, 3.3), THETA, 3.3), y, rtol=0, atol=5e-15)  # exact: two closed forms, inverse; measured 4.4e-16
 
 
 def test_steady_error_crosses_the_tolerance_of_held_inside_the_simulated_bracket():
@@ -143,7 +188,7 @@ def test_sweep_is_the_steady_state_at_each_weight_and_marks_the_end_of_the_branc
     d = circle_weight_sweep(BODY, GAINS, R, THETA, wp)
     assert list(d.w_phi) == list(wp)
     st = circle_steady_state(BODY, GAINS, R, THETA, (1, 1, 0.5))
-    assert abs(d.position_error[3] - st.position_error) < 1e-14 and abs(d.max_real[3] - st.max_real) < 1e-14  # measured 0
+    assert abs(d.position_error[3] - st.position_error) < 1e-14 and abs(d.max_real[3] - st.max_real) < 1e-14  # exact: one code path, a sweep and one point; measured 0
     assert np.isnan(d.heading[2]) and not d.stable[2]
 
 

@@ -1,0 +1,183 @@
+"""Every clause of the report's extension rows can fail: each check, fed evidence that passes
+all its clauses, says ``extended``; fed the same evidence with one clause broken (one angle
+group, one run, one parameter in turn), it says ``not reproducible``.
+
+The real evidence passes every clause (``tests/test_report.py``), so it cannot tell a check
+from one that drops a clause or lets the last group decide (``ok &= ...`` turned into
+``ok = ...``: issue 28). Here the names each check reads its evidence through (the cache and
+the library functions imported into :mod:`lib.paper.extensions`) are replaced by fakes, so
+nothing is computed. The errata's sub-cases (one k, one coefficient) are in
+``tests/test_errata_falsifiable.py``.
+"""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from lib.paper import extensions as ext
+
+ITEMS = {i.key: i for i in ext.items()}
+
+
+def _status(monkeypatch, key, **fakes):
+    """The status of extension row ``key`` with the module names ``fakes`` replaced."""
+    for name, value in fakes.items():
+        assert hasattr(ext, name), name          # a fake for a name the check no longer reads
+        monkeypatch.setattr(ext, name, value)
+    return ITEMS[key].check().status
+
+
+def _cache(**frames):
+    """A stand-in for book_cache.cached: the evidence by the computing function's name."""
+    return lambda fn, *args, **kw: frames[fn.__name__]
+
+
+# ------------------------------------------------------------------ limit-lyapunov: per angle group
+
+def _horizons(changes=(0.17, 0.17), ratios=(49.0, 49.0)):
+    """Chapter 4's convergence frame for 30 and 45 deg: the exponent at 120 periods and at the
+    longest horizon differ by ``changes`` standard errors (at 120), and the longest is
+    ``ratios`` standard errors above zero."""
+    rows = []
+    for deg, change, ratio in zip((30.0, 45.0), changes, ratios):
+        se = 0.01
+        long_ = ratio * 0.001
+        rows += [dict(angle_deg=deg, horizon=120, lyapunov=long_ + change * se, stderr=se),
+                 dict(angle_deg=deg, horizon=1920, lyapunov=long_, stderr=0.001)]
+    return pd.DataFrame(rows)
+
+
+@pytest.mark.parametrize("changes, ratios, status", [
+    ((0.17, 0.17), (49, 49), "extended"),
+    ((1.5, 0.17), (49, 49), "not reproducible"),       # the first group not converged
+    ((0.17, 1.5), (49, 49), "not reproducible"),       # the last group not converged
+    ((0.17, 0.17), (3, 49), "not reproducible"),       # the first group's exponent within 6 SE
+    ((0.17, 0.17), (49, 3), "not reproducible"),       # the last group's
+])
+def test_limit_lyapunov_row_needs_every_angle_group_converged_and_positive(monkeypatch, changes, ratios, status):
+    assert _status(monkeypatch, "limit-lyapunov", cached=_cache(lyapunov_horizons=_horizons(changes, ratios))) \
+        == status
+
+
+# ------------------------------------------------------------------ limit-mirror: each clause
+
+def _mirror_frame(paper=("A", False, 2.56), mirror="A'"):
+    """start_attractors' frame: Chapter 4's 12 heading offsets, then the mirrored start."""
+    rows = [dict(attractor="A", symmetric=False, mirror_gap=2.56) for _ in range(12)]
+    rows[6] = dict(attractor=paper[0], symmetric=paper[1], mirror_gap=paper[2])     # offset 0
+    rows.append(dict(attractor=mirror, symmetric=False, mirror_gap=2.56))
+    return pd.DataFrame(rows)
+
+
+@pytest.mark.parametrize("paper, mirror, defect, status", [
+    (("A", False, 2.56), "A'", 3e-14, "extended"),
+    (("A'", False, 2.56), "A'", 3e-14, "not reproducible"),    # the paper's start reaches the other one
+    (("A", True, 2.56), "A'", 3e-14, "not reproducible"),      # its orbit is its own mirror
+    (("A", None, 2.56), "A'", 3e-14, "not reproducible"),      # symmetry not decided
+    (("A", False, 0.5), "A'", 3e-14, "not reproducible"),      # the mirror orbit too near
+    (("A", False, 2.56), "A", 3e-14, "not reproducible"),      # the mirrored start reaches A
+    (("A", False, 2.56), "A'", 1e-6, "not reproducible"),      # the loop not symmetric
+])
+def test_limit_mirror_row_fails_with_each_of_its_clauses(monkeypatch, paper, mirror, defect, status):
+    got = _status(monkeypatch, "limit-mirror", cached=_cache(start_attractors=_mirror_frame(paper, mirror)),
+                  heading_offset_starts=lambda offsets: np.zeros((len(offsets), 6)),
+                  mirrored_start=lambda *a: np.zeros((1, 6)),
+                  mirror_defect=lambda *a: np.array([0.0, defect]))
+    assert got == status
+
+
+# ------------------------------------------------------------------ wrong-model: each run, each clause
+
+def _study(bad_run=None, column=None, verdicts=0, top=("m", "c"), gap=2e-6):
+    runs = pd.DataFrame(dict(regime=["periodic"] * 4, lost=[False] * 4, position_lost=[False] * 4,
+                             pos_max=[0.1, 0.2, 0.3, 0.4], pos_linear=[0.1, 0.2, 0.3, 0.4 + gap]))
+    if bad_run is not None:
+        runs.loc[bad_run, column] = "chaotic" if column == "regime" else True
+    rank = pd.DataFrame(dict(parameter=[*top, "I", "a"], verdicts=[verdicts, 0, 0, 0]))
+    return dict(map=runs, influence=rank)
+
+
+@pytest.mark.parametrize("study, status", [
+    (dict(), "extended"),
+    (dict(bad_run=0, column="regime"), "not reproducible"),
+    (dict(bad_run=3, column="regime"), "not reproducible"),
+    (dict(bad_run=2, column="lost"), "not reproducible"),
+    (dict(bad_run=3, column="position_lost"), "not reproducible"),
+    (dict(verdicts=1), "not reproducible"),
+    (dict(top=("m", "I")), "not reproducible"),
+    (dict(gap=2e-4), "not reproducible"),
+], ids=["all", "first-run-regime", "last-run-regime", "lost", "position-lost", "verdicts", "top", "gap"])
+def test_wrong_model_row_fails_with_each_run_and_each_clause(monkeypatch, study, status):
+    assert _status(monkeypatch, "wrong-model", cached=_cache(mismatch_study=_study(**study))) == status
+
+
+# ------------------------------------------------------------------ slow-eights: each clause
+
+def _fig5(bad=None):
+    f = pd.DataFrame(dict(R=[1.0, 2.0, 1.0, 2.0, 3.0], Theta=[0.05, 0.05, 0.2, 0.3, 0.8],
+                          regime=["periodic"] * 4 + ["chaotic"], period=[1, 1, 1, 1, 0],
+                          lost=[False] * 5, range=[0.5, 0.4, 0.6, 0.7, np.nan]))
+    if bad is not None:
+        col, row, value = bad
+        f.loc[row, col] = value
+    return f
+
+
+def _prediction(err=0.029, slips=False):
+    def predict(body, R, Theta):
+        return SimpleNamespace(corrected_range=np.array([0.5, 0.4 + err]), corrected_slips=np.array([False, slips]))
+    return predict
+
+
+@pytest.mark.parametrize("bad, err, slips, status", [
+    (None, 0.029, False, "extended"),
+    (None, 0.06, False, "not reproducible"),                    # the prediction misses the range
+    (None, 0.029, True, "not reproducible"),                    # the prediction slips
+    (("regime", 3, "quasiperiodic"), 0.029, False, "not reproducible"),   # one point of the band
+    (("period", 2, 2), 0.029, False, "not reproducible"),
+    (("lost", 0, True), 0.029, False, "not reproducible"),
+    (("regime", 4, "quasiperiodic"), 0.029, False, "extended"),           # outside the band: no matter
+])
+def test_slow_eights_row_fails_with_each_clause_and_each_point_of_the_band(monkeypatch, bad, err, slips, status):
+    assert _status(monkeypatch, "slow-eights", cached=_cache(fig5_map=_fig5(bad)),
+                   slow_eight_prediction=_prediction(err, slips)) == status
+
+
+# ------------------------------------------------------------------ window and weight-limit
+
+@pytest.mark.parametrize("width, th, gap, status", [
+    (0.0045, 0.70, 1e-9, "extended"),
+    (0.0, 0.70, 1e-9, "not reproducible"),          # no window
+    (0.02, 0.70, 1e-9, "not reproducible"),         # too wide
+    (0.0045, 0.80, 1e-9, "not reproducible"),       # closes above the paper's rate
+    (0.0045, 0.70, 1e-3, "not reproducible"),       # not the pendulum's threshold
+])
+def test_window_row_fails_with_each_clause(monkeypatch, width, th, gap, status):
+    body = ext.Body()
+    threshold = math.sqrt(body.c_phi / (body.I * th)) / (1.0 + gap)
+    assert _status(monkeypatch, "window", bistable_window=lambda body, theta: (1.0, 1.0 + width),
+                   window_closing_rate=lambda body: th, torque_pendulum_threshold=lambda: threshold) == status
+
+
+@pytest.mark.parametrize("w, below, above, status", [
+    (3.13, -1e-3, 1e-3, "extended"),
+    (3.13, 1e-3, 1e-3, "not reproducible"),         # unstable already below the limit
+    (3.13, -1e-3, -1e-3, "not reproducible"),       # still stable above it
+])
+def test_weight_limit_row_fails_with_each_clause(monkeypatch, w, below, above, status):
+    def steady(body, gains, R, Theta, weights):
+        return SimpleNamespace(eigenvalues=np.array([below if weights[2] < w else above, -1.0]))
+
+    assert _status(monkeypatch, "weight-limit",
+                   circle_weight_limit=lambda *a: SimpleNamespace(w_phi=w, kind="complex pair"),
+                   circle_steady_state=steady) == status
+
+
+def test_every_extension_row_has_a_falsifying_test():
+    tested = {"limit-lyapunov", "limit-mirror", "wrong-model", "slow-eights", "window", "weight-limit"}
+    assert set(ITEMS) == tested
