@@ -278,6 +278,7 @@ def _entry_rows():
                         "brackets (`tests/test_symbolic.py::test_symbolic_brackets_match_finite_differences`)",
             section="chapters/02_controllability",
             check=_entry_check(expr, row, corrected),
+            equations=(21,),
         ))
     return out
 
@@ -317,6 +318,7 @@ def _errata():
                         "(`tests/test_model.py::test_printed_drift_diverges_from_configuration_form`)",
             section="chapters/01_model",
             check=_check_drift_row,
+            equations=(6,),
         ),
         *_entry_rows(),
         Erratum(
@@ -328,6 +330,7 @@ def _errata():
                         "$[f,[g_1,g_2]]$ computed",
             section="chapters/02_controllability",
             check=_check_f1_name,
+            equations=(21,),
         ),
         Erratum(
             key="sec3-bracket-count",

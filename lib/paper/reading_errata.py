@@ -189,6 +189,7 @@ def _errata():
                         "the body's fields",
             section="chapters/02_controllability",
             check=_check_bracket_symbols,
+            equations=(19, 20),
             notation=True,
         ),
         Erratum(
@@ -199,6 +200,7 @@ def _errata():
             verified_by="the argument orders as transcribed (a notation slip; it changes no computation)",
             section="chapters/03_tracking",
             check=_check_n_arguments,
+            equations=(22, 23),
             notation=True,
         ),
         Erratum(
@@ -217,6 +219,7 @@ def _errata():
                         "(`lib.paper.reading_errata._check_eq24_rows`)",
             section="chapters/03_tracking",
             check=_check_eq24_rows,
+            equations=(24,),
         ),
         Erratum(
             key="eq28-arg-branch",
@@ -227,6 +230,7 @@ def _errata():
                         "(`lib.paper.reading_errata._check_arg_branch`)",
             section="chapters/03_tracking",
             check=_check_arg_branch,
+            equations=(28,),
         ),
         Erratum(
             key="theta-symbol",

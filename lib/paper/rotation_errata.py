@@ -151,7 +151,7 @@ def _errata():
             verified_by="sympy derivation of (33) from (4), (25)-(26), (27) "
                         "(`lib.stability.derive_rotation_equation`); simulation converges to the "
                         "corrected p0 (`tests/test_stability.py::test_simulated_circle_converges_to_stable_equilibrium`)",
-            section=sec, check=_check_eq33),
+            section=sec, check=_check_eq33, equations=(33,)),
         Erratum(
             key="eq33-p0",
             where="Sec. 6, the equilibria $p_0^{(k)}$ of (33)",
@@ -182,7 +182,7 @@ def _errata():
             verified_by="sympy derivation of (37) from (32) and (28) (`lib.stability.derive_eight_equation`); "
                         "the reduced equation against the full closed loop "
                         "(`tests/test_stability.py::test_reduced_rotation_matches_full_closed_loop`)",
-            section=sec, check=_check_eq37),
+            section=sec, check=_check_eq37, equations=(37,)),
         Erratum(
             key="fourier-a3",
             where="Sec. 6, the 3-term series of the eight's tangent angle",

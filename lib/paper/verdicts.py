@@ -34,6 +34,8 @@ class Erratum:
     (a document path such as ``chapters/01_model``) that shows it. ``notation``: a slip of
     notation or numbering that changes no computation; such a row does not make the report
     row of its equations "corrected" (:func:`lib.paper.outcomes.legend_status`).
+    ``equations``: the numbers of the paper's equations whose printed form the row corrects
+    (none for a claim, a definition or a theorem without a number).
     """
 
     key: str
@@ -44,3 +46,4 @@ class Erratum:
     section: str
     check: Callable[[], Verdict]
     notation: bool = False
+    equations: tuple[int, ...] = ()
