@@ -17,7 +17,7 @@ import pytest
 import sympy as sp
 
 from lib.controllability import paper_bracket_count, witt_dimension
-from lib.paper import errata, model_errata, reading_errata as rd
+from lib.paper import errata, model_errata, reading_errata as rd, rotation_errata as ro
 from lib.paper.rotation_errata import CORRECTED_HEADING_SERIES
 from lib.rotation.equations import (corrected_p0, derive_eight_equation, derive_rotation_equation,
                                     printed_eq33, printed_eq37, printed_p0)
@@ -94,11 +94,15 @@ CASES = {
                                         dict(printed=model_errata._theorem6_corrected, corrected=_always_stlc)],
     "sec3-stlc-conclusion": _claims,
     "sec3-rank-condition": _rank_cases,
+    "thm7-drift": lambda: [dict(printed=model_errata._theorem7, corrected=model_errata._theorem7_as_used),
+                           dict(printed=model_errata._theorem7, corrected=lambda *a: False)],
     "table-number": lambda: [dict(printed=1, corrected=5), dict(printed=1, corrected=2)],
     "eq33-cos-sign": _eq33_cases,
     "eq33-p0": lambda: [dict(printed=corrected_p0, corrected=printed_p0),
                         dict(printed=corrected_p0, corrected=lambda k: corrected_p0(k) + sp.Rational(1, 100))],
     "eq37-bracket": _eq37_cases,
+    "sec6-global-stability": lambda: [dict(printed=ro._global_outside_window, corrected=ro._global_as_printed),
+                                      dict(printed=ro._global_outside_window, corrected=lambda b, R, th: True)],
     "fourier-a3": lambda: [dict(printed=CORRECTED_HEADING_SERIES, corrected=PAPER_HEADING_SERIES),
                            dict(printed=CORRECTED_HEADING_SERIES, corrected={**CORRECTED_HEADING_SERIES, 5: 0.17})],
     # the line-by-line audit (lib.paper.reading_errata)

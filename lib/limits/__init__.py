@@ -7,7 +7,9 @@
 * :mod:`.verdicts`: ``limit_verdicts``, the regime under an angle limit and a force cap
   decided by :mod:`lib.dynamics.verdicts`; ``extend_undecided``, ``regime_edges``;
 * :mod:`.attractors`: the closed loop's mirror symmetry on the eight, the attractors the
-  starts reach, the Lyapunov exponent over horizons.
+  starts reach, the Lyapunov exponent over horizons;
+* :mod:`.torus`: where the quasi-periodic regime is born, a Neimark-Sacker bifurcation of the
+  period-1 orbit along the cap (``torus_birth``), and the invariant circle's rotation number.
 
 ``lib.limits`` is a public face: it re-exports the names readers use.
 """

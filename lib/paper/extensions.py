@@ -26,7 +26,7 @@ from ..rotation.verdicts import fig5_map
 from ..rotation.slow_eight import slow_eight_prediction
 from ..trajectories import eight
 from ..weighting.circle import circle_steady_state, circle_weight_limit
-from .outcomes import Item, Outcome, decide
+from .outcomes import Item, Outcome, legend_status
 
 __all__ = ["items"]
 
@@ -42,7 +42,7 @@ def _check_window() -> Outcome:
     # where the window closes, the normalised damping is the damped pendulum's threshold
     gap = abs(math.sqrt(body.c_phi / (body.I * th)) / torque_pendulum_threshold() - 1.0)
     ok = 0.0 < width < 0.01 and th < THETA0 and gap < 1e-6    # measured: 0.0045, 0.70 rad/s, rounding
-    return Outcome(decide(ok, "extended"), width,
+    return Outcome(legend_status(ok, extension=True), width,
                    "relative width R_edge / R_crit - 1 of the bistable window at Theta = pi/4",
                    f"located as a homoclinic connection (shooting); the window closes below Theta = {th:.4f} "
                    "rad/s, where the normalised damping is the damped pendulum's classical threshold "
@@ -59,7 +59,7 @@ def _check_weighted_circle() -> Outcome:
 
     below, above = growth(0.99 * w), growth(1.01 * w)
     ok = np.isfinite(w) and below < 0.0 < above
-    return Outcome(decide(ok, "extended"), w,
+    return Outcome(legend_status(ok, extension=True), w,
                    "the circle's exact weight limit w_phi (w_x = w_y = 1), Chapter 6",
                    f"the steady motion is an equilibrium in the rotating frame; it loses stability by a "
                    f"{lim.kind} (largest real part {below:.2e} at 0.99 w_phi, {above:.2e} at 1.01 w_phi); "
@@ -75,7 +75,7 @@ def _check_slow_eights() -> Outcome:
     err = float(np.max(np.abs(pred.corrected_range - low["range"].to_numpy())))
     settled = bool(((band.regime == "periodic") & (band.period == 1) & ~band.lost).all())
     ok = err < 0.05 and settled and not pred.corrected_slips.any()    # measured 0.029 rad at Theta = 0.05
-    return Outcome(decide(ok, "extended"), err,
+    return Outcome(legend_status(ok, extension=True), err,
                    f"largest error (rad) of the slow-eight range at Theta = {float(low.Theta.iloc[0]):.3g} rad/s",
                    "the overdamped heading with its first inertia correction predicts the range of p on slow "
                    "eights; every point of the map with Theta <= 0.3 rad/s settles on a period-1 orbit, "
@@ -89,7 +89,7 @@ def _check_wrong_model() -> Outcome:
     lin = float(np.max(np.abs(runs.pos_max - runs.pos_linear)))
     top = tuple(rank.parameter.iloc[:2])
     ok = kept and int(rank.verdicts.sum()) == 0 and set(top) == {"m", "c"} and lin < 1e-4   # measured 2e-6 m
-    return Outcome(decide(ok, "extended"), lin,
+    return Outcome(legend_status(ok, extension=True), lin,
                    "largest gap (m) between the simulated steady error and the forced error equation",
                    f"model off by up to 20 %: the two parameters that matter are {top[0]} and {top[1]} (I_C, "
                    "c_phi, a do not enter (25)-(26)); every run's heading keeps its verdict and the "
@@ -112,7 +112,7 @@ def _check_mirror() -> Outcome:
     asymmetric = paper.symmetric is not None and not bool(paper.symmetric)
     ok = paper.attractor == "A" and asymmetric and paper.mirror_gap > 1.0 and mirror.attractor == "A'" \
         and defect < 1e-9                                                        # measured 2.56, 3e-14
-    return Outcome(decide(bool(ok), "extended"), float(paper.mirror_gap),
+    return Outcome(legend_status(bool(ok), extension=True), float(paper.mirror_gap),
                    "distance from the paper's attractor at a 90 deg limit to its mirror image",
                    "the closed loop under the limits is symmetric under the reflection with half a period "
                    f"(a run and its mirror agree to {defect:.0e}); the paper's start reaches an orbit that is "
@@ -129,7 +129,7 @@ def _check_lyapunov() -> Outcome:
         change = abs(short.lyapunov - long_.lyapunov) / short.stderr
         worst = max(worst, change)
         ok &= change < 1.0 and long_.lyapunov > 6 * long_.stderr             # measured 0.17, 49 SE
-    return Outcome(decide(bool(ok), "extended"), worst,
+    return Outcome(legend_status(bool(ok), extension=True), worst,
                    "largest change of the exponent from 120 to 1920 periods, in standard errors at 120",
                    "the chaotic verdicts' exponents at 30 and 45 deg are converged in the horizon; "
                    "Chapter 4 also shows them independent of the initial separation d0")
@@ -143,7 +143,7 @@ def _check_percussion_circle() -> Outcome:
     st = circle_steady_motion(body, R_P, THETA0)
     gap = abs(st.radius_C / R0 - 1.0)
     ok = gap < 1e-12 and circle_lock_radius(body, THETA0) < circle_critical_radius(body, THETA0) and st.rate < 0
-    return Outcome(decide(ok, "extended"), st.rate,
+    return Outcome(legend_status(ok, extension=True), st.rate,
                    "the heading's rate (1/s) on the circle with P on the paper's P-circle, Chapter 7",
                    f"closed form; given the circle P runs under the paper's law, C's closed-form circle is the "
                    f"paper's R (agreement {gap:.1e}); the lock radius lies below the paper's (36)")
@@ -153,7 +153,7 @@ def _check_percussion_map() -> Outcome:
     fr = percussion_fig5_map(Body(), n=100)
     held = float(((fr.regime == "periodic") & ~fr.lost).mean())
     ok = held == 1.0 and not (fr.regime == "chaotic").any()     # Chapter 7: every point held
-    return Outcome(decide(ok, "extended"), held,
+    return Outcome(legend_status(ok, extension=True), held,
                    "share of Fig. 5's 100 x 100 grid where the heading is held under the law for P",
                    "decided by lib.dynamics.verdicts on the zero dynamics' exact period map (a Moebius map: "
                    "no chaos)")

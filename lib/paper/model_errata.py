@@ -131,6 +131,48 @@ def _check_theorem6(printed=None, corrected=None) -> Verdict:
     )
 
 
+def _theorem7_as_used(fields, q, at, brackets) -> bool:
+    """Theorem 7 as the conclusion of Sec. 3 uses it: controllable if locally accessible at
+    ``at`` (the brackets ``brackets`` span), whether or not the system has a drift."""
+    return accessibility_matrix(fields, brackets, q).subs(at).rank() == len(q)
+
+
+def _theorem7(fields, q, at, brackets) -> bool:
+    """Theorem 7 within its hypothesis (Chow-Rashevskii): a system *without drift* that is
+    locally accessible is (globally) controllable; it says nothing about one with a drift."""
+    driftless = "f" not in fields or all(e == 0 for e in fields["f"])
+    return driftless and _theorem7_as_used(fields, q, at, brackets)
+
+
+def _check_theorem7(printed=None, corrected=None) -> Verdict:
+    """Theorem 7 as applied in Sec. 3: ``printed`` and ``corrected`` are inferences
+    (fields, q, point, brackets) -> whether they conclude the system controllable
+    (defaults :func:`_theorem7_as_used`, :func:`_theorem7`). An inference fails if it
+    concludes it for the system with drift x1' = u, x2' = x1^2, which is accessible at 0
+    and never lowers x2; the corrected one must still conclude it for the driftless
+    x1' = u1, x2' = x1 u2 (accessible through [g1, g2], Chow). The body's drift is not zero
+    at a moving state, so the theorem does not apply to (5)."""
+    printed = _theorem7_as_used if printed is None else printed
+    corrected = _theorem7 if corrected is None else corrected
+    q, fields = _counterexample()
+    at0 = {q[0]: 0, q[1]: 0}
+    rate = fields["f"][1] + fields["g"][1] * sp.Symbol("u", real=True)
+    never_lowers = bool(rate.is_nonnegative)        # (0, -eps) is never reached: not controllable
+    x1, x2 = q
+    driftless = {"g1": sp.Matrix([1, 0]), "g2": sp.Matrix([0, x1])}
+    concludes_driftless = corrected(driftless, q, at0, ["g1", "g2", ("g1", "g2")])
+    model = derive_body_frame()
+    moving = {v: 1 for v in model.q[3:]}
+    drift_moving = sp.simplify(model.f.subs(moving).subs({model.q[2]: 0}))
+    return Verdict(
+        printed_holds=not (printed(fields, q, at0, _COUNTER_BRACKETS) and never_lowers),
+        corrected_holds=not (corrected(fields, q, at0, _COUNTER_BRACKETS) and never_lowers) and concludes_driftless,
+        detail=f"x1'=u, x2'=x1^2: accessible at 0, x2' >= 0 always; the driftless x1'=u1, x2'=x1 u2 accessible: "
+               f"{concludes_driftless}; the body's drift at v1 = v2 = omega = 1, phi = 0 is nonzero: "
+               f"{not drift_moving.is_zero_matrix}",
+    )
+
+
 def _stlc_claims(model):
     """The sets of states where the conclusion claims STLC, as sympy conditions on
     (v1, v2, omega): as printed (omega != a m v2 / I_C) and as corrected (at rest)."""
@@ -236,6 +278,7 @@ def _entry_rows():
                         "brackets (`tests/test_symbolic.py::test_symbolic_brackets_match_finite_differences`)",
             section="chapters/02_controllability",
             check=_entry_check(expr, row, corrected),
+            equations=(21,),
         ))
     return out
 
@@ -275,6 +318,7 @@ def _errata():
                         "(`tests/test_model.py::test_printed_drift_diverges_from_configuration_form`)",
             section="chapters/01_model",
             check=_check_drift_row,
+            equations=(6,),
         ),
         *_entry_rows(),
         Erratum(
@@ -286,6 +330,7 @@ def _errata():
                         "$[f,[g_1,g_2]]$ computed",
             section="chapters/02_controllability",
             check=_check_f1_name,
+            equations=(21,),
         ),
         Erratum(
             key="sec3-bracket-count",
@@ -308,6 +353,19 @@ def _errata():
             verified_by="counterexample computed with `lie_bracket`; `lib.controllability.sussmann_check`",
             section="chapters/02_controllability",
             check=_check_theorem6,
+        ),
+        Erratum(
+            key="thm7-drift",
+            where="Sec. 3, Theorem 7 as used in the last sentence (\"theory 7\")",
+            printed="Theorem 7 (a system *without drift* that is locally accessible is globally controllable), "
+                    "cited to conclude that (5), a system *with* drift, is small-time locally controllable",
+            corrected="misapplied: Theorem 7 (Chow) holds for systems without drift only; (5) has a drift, and "
+                      "with a drift accessibility implies no controllability ($\\dot x_1 = u$, "
+                      "$\\dot x_2 = x_1^2$ is accessible at 0 and never lowers $x_2$)",
+            verified_by="the counterexample and a driftless system checked with `accessibility_matrix`; "
+                        "the body's drift at a moving state (`lib.paper.model_errata._check_theorem7`)",
+            section="chapters/02_controllability",
+            check=_check_theorem7,
         ),
         Erratum(
             key="sec3-stlc-conclusion",

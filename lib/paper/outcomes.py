@@ -11,19 +11,21 @@ from typing import Callable
 
 import numpy as np
 
-__all__ = ["STATUSES", "Outcome", "Item", "decide"]
+__all__ = ["STATUSES", "Outcome", "Item", "legend_status"]
 
 STATUSES = ("reproduced", "corrected", "refuted", "not reproducible", "extended")
 
 
 @dataclass(frozen=True)
 class Outcome:
-    """Result of a report check: the status, a figure of merit with its label, a note."""
+    """Result of a report check: the status, a figure of merit with its label, a note, the
+    errata row it links, and whether the check found a counterexample to the paper's claim."""
     status: str
     merit: float
     merit_label: str
     note: str = ""
     erratum: str | None = None
+    counterexample: bool = False
 
     def __post_init__(self) -> None:
         if self.status not in STATUSES:
@@ -42,6 +44,39 @@ class Item:
     check: Callable[[], Outcome]
 
 
-def decide(ok: bool, good: str, bad: str = "not reproducible") -> str:
-    """The status a check decides: the row's claimed status ``good`` when ``ok``, else ``bad``."""
-    return good if ok else bad
+def legend_status(evidence: bool, *, printed_fails: bool = False, counterexample: bool = False,
+                  extension: bool = False) -> str:
+    """The report's legend as one rule: the status of a row from what its check established.
+
+    - ``evidence`` False (the computation does not confirm the row): **not reproducible**;
+    - ``extension`` (the book goes beyond the paper): **extended**;
+    - ``counterexample`` (a case where the paper's claim, as printed and as it is used, is
+      false: a bistable window against "globally", a system with drift against a theorem
+      for systems without one): **refuted**, however much of it survives;
+    - ``printed_fails`` (an errata row on the row's equations, not a slip of notation only,
+      confirms that the printed form fails and the corrected one holds): **corrected**;
+    - else: **reproduced**, the paper's statement holds as printed.
+
+    Parameters
+    ----------
+    evidence : bool
+        The check confirmed its evidence.
+    printed_fails : bool
+        A confirmed errata row (not ``notation``) on the row's equations or claim.
+    counterexample : bool
+        The check exhibits a counterexample to the claim.
+    extension : bool
+        The row is one of the book's extensions.
+
+    Returns
+    -------
+    str
+        One of :data:`STATUSES`.
+    """
+    if not evidence:
+        return "not reproducible"
+    if extension:
+        return "extended"
+    if counterexample:
+        return "refuted"
+    return "corrected" if printed_fails else "reproduced"

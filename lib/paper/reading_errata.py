@@ -77,8 +77,10 @@ def _interior(lo, hi, q0):
 def _check_definition2(printed=_membership, corrected=_interior) -> Verdict:
     """Definition 2, small-time local controllability: ``printed`` and ``corrected`` are the
     tests a definition applies to the reachable set R(q0, <= T) = [lo, hi] (an interval, for
-    scalar systems), here at T = 1e-3, 0.1 and 1 s: as printed, q0 lies in it; as corrected
-    (Sussmann, Lewis), q0 lies in its interior, for every T > 0. A definition is right if it
+    scalar systems), here at T = 1e-3, 0.1 and 1 s: as printed ("inside" read as
+    membership), q0 lies in it; as corrected (Sussmann, Lewis), q0 lies in its interior. The
+    printed quantifiers ("there exists T > 0 ... for each time in [0, T]") are kept: the
+    reachable set grows with T, so they say the same as "for every T > 0". A definition is right if it
     calls x' = u, |u| <= 1 (R = [-T, T]) STLC and x' = u, 0 <= u <= 1 (R = [0, T], which can
     never move left) not."""
     Ts = (1e-3, 0.1, 1.0)
@@ -167,8 +169,12 @@ def _errata():
         Erratum(
             key="def2-stlc",
             where="Sec. 3, Definition 2, small-time local controllability",
-            printed=r"there exists $T > 0$ such that $q_0$ is inside $\mathcal R_S(q_0, \le T)$",
-            corrected=r"$q_0$ lies in the *interior* of $\mathcal R_S(q_0, \le T)$ for *every* $T > 0$",
+            printed=r"small-time locally controllable from the state $q_0$ if there exists time $T > 0$ such that "
+                    r"the state $q_0$ is inside the set $\mathcal R_S(q_0, \le T)$ for each time in $[0, T]$",
+            corrected=r"the same with *in the interior of* for *inside*: $q_0$ lies in the interior of "
+                      r"$\mathcal R_S(q_0, \le t)$ for each $t$ in $(0, T]$ (at $t = 0$ the set is $\{q_0\}$). "
+                      r"The quantifiers are right (the set grows with $t$, so this holds for every $t > 0$); "
+                      r"read as membership, *inside* holds for every system",
             verified_by="a one-sided system, $\\dot x = u$ with $0 \\le u \\le 1$, which the printed wording calls "
                         "STLC (`lib.paper.reading_errata._check_definition2`)",
             section="chapters/02_controllability",
@@ -183,6 +189,8 @@ def _errata():
                         "the body's fields",
             section="chapters/02_controllability",
             check=_check_bracket_symbols,
+            equations=(19, 20),
+            notation=True,
         ),
         Erratum(
             key="eq22-23-N-order",
@@ -192,16 +200,26 @@ def _errata():
             verified_by="the argument orders as transcribed (a notation slip; it changes no computation)",
             section="chapters/03_tracking",
             check=_check_n_arguments,
+            equations=(22, 23),
+            notation=True,
         ),
         Erratum(
             key="eq24-rows",
-            where="Sec. 4, (24) and the claim after it",
-            printed=r"$M\ddot e + K_v\dot e + K_p e = 0$ for all three errors, so all converge",
-            corrected=r"(24) holds in the $x$ and $y$ rows only: (25)-(26) drop the torque demand, and $p$ obeys (32)",
+            where="Sec. 4, (24), as Sec. 5 uses it with (25)-(26)",
+            printed=r"substituting (23) into (22) leads to $M\ddot e + K_v\dot e + K_p e = 0$ (24), "
+                    r"$e = z_d - z$, which 'proves exponential convergence of the errors to zero'. The paper "
+                    r"derives it for $Q = \tau$, at once raises the problem of representing $\tau$ by $Q$, "
+                    r"drops the rotation control in (25)-(26), and in Sec. 5 cites (24) for the loop with "
+                    r"(23), (25)-(26) to prove (29)-(30), expecting only a constant rotation error (31); "
+                    r"which rows of (24) hold under (25)-(26) it does not say",
+            corrected=r"under (23) with (25)-(26) the $x$ and $y$ rows of (24) hold exactly "
+                      r"($Q_x = \tau_x$, $Q_y = \tau_y$), so (29)-(30) follow; the $\varphi$ row does not "
+                      r"($Q_\varphi = Fa\sin\beta \ne \tau_\varphi$): the rotation error obeys (32)",
             verified_by="the circle simulated 20 s against (24)'s solution, row by row "
                         "(`lib.paper.reading_errata._check_eq24_rows`)",
             section="chapters/03_tracking",
             check=_check_eq24_rows,
+            equations=(24,),
         ),
         Erratum(
             key="eq28-arg-branch",
@@ -212,6 +230,7 @@ def _errata():
                         "(`lib.paper.reading_errata._check_arg_branch`)",
             section="chapters/03_tracking",
             check=_check_arg_branch,
+            equations=(28,),
         ),
         Erratum(
             key="theta-symbol",
@@ -221,6 +240,7 @@ def _errata():
             verified_by="the symbols as transcribed (a notation slip; it changes no computation)",
             section="chapters/05_stability",
             check=_check_rate_symbol,
+            notation=True,
         ),
     ]
 

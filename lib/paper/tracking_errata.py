@@ -45,6 +45,7 @@ def _errata():
                         "inconsistent, not what the typesetter intended",
             section="chapters/03_tracking",
             check=_check_table_number,
+            notation=True,
         ),
     ]
 

@@ -31,7 +31,11 @@ class Erratum:
 
     ``printed`` and ``corrected`` are MyST/LaTeX snippets (inline math in $...$);
     ``verified_by`` names the test or the computation; ``section`` the book page
-    (a document path such as ``chapters/01_model``) that shows it.
+    (a document path such as ``chapters/01_model``) that shows it. ``notation``: a slip of
+    notation or numbering that changes no computation; such a row does not make the report
+    row of its equations "corrected" (:func:`lib.paper.outcomes.legend_status`).
+    ``equations``: the numbers of the paper's equations whose printed form the row corrects
+    (none for a claim, a definition or a theorem without a number).
     """
 
     key: str
@@ -41,3 +45,5 @@ class Erratum:
     verified_by: str
     section: str
     check: Callable[[], Verdict]
+    notation: bool = False
+    equations: tuple[int, ...] = ()

@@ -14,11 +14,11 @@ import numpy as np
 from ..angles import wrap_angle
 from ..integrators import batch
 from ..params import Body
-from .reduced import ENGINES, _forcing, _shape, _unit_forcing
+from .reduced import ENGINES, _forcing, _shape, _unit_forcing, steps_per_period
 from ..dynamics.sampled import sampled_range
 from .field import coefficients, rotation_rates, rotation_rates_dphi
 
-__all__ = ["verdict_steps", "RotationMap", "orbit_range"]
+__all__ = ["verdict_steps", "RotationMap", "orbit_range", "check_domain", "MAX_DAMPING_PERIODS", "MAX_STEPS"]
 
 
 def verdict_steps(body: Body, kind: str, R, Theta, h_lambda: float = 0.125, h_damp: float = 1.0) -> np.ndarray:
@@ -217,3 +217,54 @@ def orbit_range(eng: _Engine, x, A, B, C, k: int, slip) -> tuple[np.ndarray, np.
         out[~cyc] = sampled_range(np.column_stack([p0, p[~cyc]]), cyclic=False,
                                   dy=np.column_stack([dp0, dp[~cyc]]), h=eng.h)
     return out, mirror
+
+
+#: where the rotation's verdicts are meant to hold (issue 27): the heading's damping time I_C / c_phi
+#: is at most this many reference periods (the verdicts' transient runs 48, so a start is forgotten
+#: before the orbit search begins), and a period needs at most ``MAX_STEPS`` fixed steps (beyond, a
+#: point costs minutes: R far beyond the body's scale)
+MAX_DAMPING_PERIODS = 8.0
+MAX_STEPS = 2 ** 14
+
+
+def check_domain(body: Body, kind: str, R, Theta, h_lambda: float = 0.125) -> np.ndarray:
+    """Refuse points outside the domain of the rotation's verdicts, naming the first one and
+    the bound it breaks, and return the steps per period of the others
+    (:func:`lib.rotation.reduced.steps_per_period`).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    kind : str
+        ``"eight"`` or ``"circle"``.
+    R, Theta : numpy.ndarray
+        Radii (m) and rates (rad/s), 1-D, of equal length, already checked.
+    h_lambda : float
+        The bound on h Lambda.
+
+    Returns
+    -------
+    numpy.ndarray
+        Steps per period (int), one per point.
+
+    Raises
+    ------
+    ValueError
+        If a rate makes the heading's damping time longer than :data:`MAX_DAMPING_PERIODS`
+        periods, or a point needs more than :data:`MAX_STEPS` steps a period.
+    """
+    theta_max = 2 * np.pi * MAX_DAMPING_PERIODS * body.c_phi / body.I
+    bad = np.flatnonzero(Theta > theta_max)
+    if bad.size:
+        i = int(bad[0])
+        raise ValueError(f"Theta[{i}] = {Theta[i]:g} rad/s is outside the verdicts' domain Theta <= {theta_max:.4g} "
+                         f"rad/s (2 pi {MAX_DAMPING_PERIODS:g} c_phi / I_C): the heading would keep its start for more "
+                         "than the transient the verdicts allow")
+    steps = steps_per_period(body, kind, R, Theta, h_lambda)
+    bad = np.flatnonzero(steps > MAX_STEPS)
+    if bad.size:
+        i = int(bad[0])
+        raise ValueError(f"R[{i}] = {R[i]:g} m with Theta[{i}] = {Theta[i]:g} rad/s is outside the verdicts' domain: "
+                         f"a period needs {steps[i]} steps, more than {MAX_STEPS} (R far beyond the body's scale)")
+    return steps

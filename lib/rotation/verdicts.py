@@ -25,8 +25,8 @@ from ..dynamics import verdicts as dv
 from ..dynamics.orbits import floquet_multipliers
 from ..machinery.parallel import concat_frames, map_chunks
 from ..params import Body
-from .reduced import ENGINES, _check_grid, _initial, check_domain
-from .engine import RotationMap, _Engine, orbit_range, verdict_steps
+from .reduced import ENGINES, _check_grid, _initial
+from .engine import RotationMap, _Engine, check_domain, orbit_range, verdict_steps
 from .field import coefficients
 
 __all__ = ["REGIMES", "VERDICT_DEFAULTS", "SLOW_FLOQUET", "verdict_steps", "section_returns", "rotation_verdicts",
