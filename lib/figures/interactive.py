@@ -242,7 +242,7 @@ def limit_sweep_figure(sweeps: Mapping[str, tuple[pd.DataFrame, np.ndarray]], *,
     return fig
 
 
-#: plotly's options for the book's figures: no logo link, no cloud export, resize with the page
+#: plotly's options for the book's figures (no logo link, no cloud export, resize with the page)
 PLOTLY_CONFIG = {"displaylogo": False, "responsive": True,
                  "modeBarButtonsToRemove": ["sendDataToCloud", "select2d", "lasso2d"]}
 
