@@ -8,7 +8,11 @@ browser session, and check that it reads correctly:
 - every Markdown table (in the text or emitted by a cell) rendered as a table;
 - no code line wider than its code block;
 - every figure's alt text a sentence, not a file name;
-- on the report page, every status one of those its legend defines.
+- on the report page, every status one of those its legend defines, and its table within
+  the content area with every column at least 120 px wide;
+- hovering known points of the interactive figures (Fig. 5 in Chapter 5, the angle-limit
+  diagram in Chapter 4) with the mouse shows a tooltip with their verdict, and plotly.js
+  comes from the book's ``_static``.
 
 The pages are visited once (fixture ``pages``); each check is its own test, so a
 failure names the page and the check. Needs Debian's ``chromium`` (``.ci/run``
@@ -359,3 +363,148 @@ def test_report_statuses_come_from_its_legend(pages):
     off = [f"row {r['row']!r}: status {r['status']!r}" for r in rows
            if re.sub(r"\s*\(.*\)\s*$", "", r["status"]) not in legend]
     assert not off, f"report: statuses outside its legend {sorted(legend)}:\n  " + "\n  ".join(off)
+
+
+# ---------------------------------------------------------------- hovering the interactive figures
+
+#: where to find the plot of a figure (its plotly div id) and the page it is on
+INTERACTIVE = {"interactive-fig5": "chapters/05_stability",
+               "interactive-bifurcation": "chapters/04_limits"}
+
+#: points whose verdict the chapters establish, hovered with the mouse: (figure, x axis, y axis,
+#: x, y or None for "a point of that trace at x", verdict). Fig. 5's corners: the slow small
+#: eight at R = 0.25 m, Theta = 0.05 rad/s is periodic, the large fast one at R = 4 m,
+#: Theta = 1.5 rad/s chaotic; the angle-limit sweep (Chapter 4 asserts both): chaotic at 30 deg
+#: without a cap (top left, and its exponent beneath), periodic at 60 deg with the cap (top right).
+HOVER_POINTS = [
+    ("interactive-fig5", "x", "y", 0.25, 0.05, "periodic"),
+    ("interactive-fig5", "x", "y", 4.0, 1.5, "chaotic"),
+    ("interactive-bifurcation", "x", "y", 30.0, None, "chaotic"),
+    ("interactive-bifurcation", "x3", "y3", 30.0, None, "chaotic"),
+    ("interactive-bifurcation", "x2", "y2", 60.0, None, "periodic"),
+]
+
+#: the page coordinates of data point (x, y) on the axes (xa, ya) of the plot with id `id`;
+#: y null: the y of a point of a trace on those axes at that x
+POINT_XY = r"""(a) => {
+  const gd = document.getElementById(a.id);
+  let y = a.y;
+  if (y === null) {
+    const near = (t) => Array.from(t.x).findIndex(v => Math.abs(v - a.x) < 1e-6);
+    const tr = gd._fullData.find(t => t.xaxis === a.xa && t.yaxis === a.ya && t.x && near(t) >= 0);
+    if (!tr) return null;
+    y = tr.y[near(tr)];
+  }
+  gd.scrollIntoView({block: 'center'});
+  const fl = gd._fullLayout;
+  const xa = fl[a.xa.replace('x', 'xaxis')], ya = fl[a.ya.replace('y', 'yaxis')];
+  const r = gd.getBoundingClientRect();
+  return {x: r.left + xa._offset + xa.l2p(a.x), y: r.top + ya._offset + ya.l2p(y)};
+}"""
+
+#: the lines of the tooltip shown
+TOOLTIP = r"""() => Array.from(document.querySelectorAll('.hoverlayer .hovertext')).map(h =>
+  Array.from(h.querySelectorAll('tspan.line')).map(t => t.textContent).join('\n') || h.textContent)"""
+
+#: the report's table with a 'status' column: its width against the article's, its
+#: scrolling box's overflow, and its columns' widths (px)
+TABLE_FIT = r"""() => {
+  const t = Array.from(document.querySelectorAll('main table')).find(t =>
+      Array.from(t.querySelectorAll('thead th')).some(th => th.textContent.trim() === 'status'));
+  if (!t) return null;
+  const article = t.closest('article') || document.querySelector('main');
+  const box = t.closest('.pst-scrollable-table-container') || t.parentElement;
+  const a = article.getBoundingClientRect(), r = t.getBoundingClientRect();
+  return {tableLeft: r.left, tableRight: r.right, articleLeft: a.left, articleRight: a.right,
+          boxScroll: box.scrollWidth, boxClient: box.clientWidth, viewport: window.innerWidth,
+          columns: Array.from(t.querySelectorAll('thead th')).map(th =>
+              ({name: th.textContent.trim(), width: th.getBoundingClientRect().width}))};
+}"""
+
+
+@dataclass
+class Hovered:
+    """What hovering the interactive figures and measuring the report's table found."""
+    tooltips: dict = field(default_factory=dict)
+    table: dict | None = None
+    requests: list[str] = field(default_factory=list)
+    failed: list[str] = field(default_factory=list)
+
+
+@pytest.fixture(scope="module")
+def hovered(server) -> Hovered:
+    """The pages with interactive figures, read again in Chromium at 1280 px: each point of
+    HOVER_POINTS hovered with the mouse and its tooltip read; the report's table measured."""
+    if not Path(CHROMIUM).exists():
+        pytest.skip(f"Debian's chromium is not installed ({CHROMIUM} missing): browser test skipped")
+    from playwright.sync_api import sync_playwright
+
+    out = Hovered()
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, headless=True, args=[
+            "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+            "--disable-background-networking", "--disable-component-update", "--disable-sync"])
+        page = browser.new_context(viewport=VIEWPORT).new_page()
+        page.on("request", lambda r: out.requests.append(r.url))
+        page.on("requestfailed", lambda r: out.failed.append(r.url))
+        for doc in sorted(set(INTERACTIVE.values())):
+            page.goto(f"{server}/{doc}.html", wait_until="networkidle")
+            for point in HOVER_POINTS:
+                fig, xa, ya, x, y, _ = point
+                if INTERACTIVE[fig] != doc:
+                    continue
+                page.wait_for_function("(id) => { const g = document.getElementById(id); "
+                                       "return g && g._fullLayout; }", arg=fig, timeout=20_000)
+                xy = page.evaluate(POINT_XY, dict(id=fig, xa=xa, ya=ya, x=x, y=y))
+                tips = []
+                if xy is not None:
+                    page.mouse.move(1, 1)
+                    page.mouse.move(xy["x"], xy["y"], steps=4)
+                    try:
+                        page.wait_for_selector(".hoverlayer .hovertext", timeout=5_000)
+                    except Exception:
+                        pass
+                    tips = page.evaluate(TOOLTIP)
+                out.tooltips[point] = tips
+        page.goto(f"{server}/report.html", wait_until="networkidle")
+        out.table = page.evaluate(TABLE_FIT)
+        browser.close()
+    return out
+
+
+@pytest.mark.parametrize("point", HOVER_POINTS, ids=lambda p: f"{p[0]}-{p[1]}-{p[3]:g}")
+def test_hovering_a_known_point_shows_its_verdict(point, hovered):
+    fig, _, _, x, y, verdict = point
+    tips = hovered.tooltips.get(point)
+    assert tips, f"{INTERACTIVE[fig]}: no tooltip on hovering ({x}, {y}) of #{fig} (did plotly.js load?)"
+    lines = tips[0].splitlines()
+    shown = [ln.split(": ", 1)[1] for ln in lines if ln.startswith("verdict: ")]
+    assert shown and shown[0].split(",")[0] == verdict, f"#{fig} at ({x}, {y}): tooltip {lines}"
+    label = "R: " if fig == "interactive-fig5" else "angle limit: "
+    value = [ln for ln in lines if ln.startswith(label)]
+    assert value and abs(float(value[0][len(label):].split()[0]) - x) < 1e-3, (
+        f"#{fig}: hovered ({x}, {y}) but the tooltip is of another point: {lines}")
+    for name in ("period", "largest |μ|", "exponent", "range of p"):
+        assert any(ln.startswith(name) for ln in lines), f"#{fig}: no {name!r} in the tooltip {lines}"
+    assert not any("NaN" in ln or "nan" in ln for ln in lines), lines
+
+
+def test_interactive_figures_load_plotly_from_the_book_alone(hovered):
+    outside = [u for u in hovered.requests
+               if urlparse(u).scheme not in ("data", "blob", "about") and urlparse(u).hostname != "127.0.0.1"]
+    assert not outside, f"requests left the loopback address: {outside}"
+    assert not hovered.failed, f"requests failed: {hovered.failed}"
+    assert any(urlparse(u).path.endswith("/_static/plotly.min.js") for u in hovered.requests), (
+        "plotly.js was not loaded from the book's _static")
+
+
+def test_the_report_table_fits_the_content_area_at_1280px(hovered):
+    t = hovered.table
+    assert t, "report: no table with a 'status' column found"
+    assert t["boxScroll"] <= t["boxClient"] + 1, (
+        f"report: the table scrolls sideways at {VIEWPORT['width']} px: {t['boxScroll']} > {t['boxClient']} px")
+    assert t["articleLeft"] - 1 <= t["tableLeft"] and t["tableRight"] <= t["articleRight"] + 1, (
+        f"report: the table ({t['tableLeft']:.0f}-{t['tableRight']:.0f} px) leaves the content area "
+        f"({t['articleLeft']:.0f}-{t['articleRight']:.0f} px)")
+    narrow = [f"{c['name']} ({c['width']:.0f} px)" for c in t["columns"] if c["width"] < 120]
+    assert not narrow, f"report: columns narrower than 120 px at {VIEWPORT['width']} px: {narrow}"
