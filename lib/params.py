@@ -23,10 +23,10 @@ PAPER_Z0 = (1.0, 0.0, math.pi / 2)
 PAPER_DZ0 = (0.0, 0.0, 0.0)
 
 
-#: the range of each of the body's parameters (in SI units) that the book's methods serve:
-#: absolute tolerances (1e-10 and looser) on states of order one, explicit integrators whose
-#: steps scale with the ratios c/m, c_phi/I_C (``simulate`` refuses a run whose step count these
-#: ratios would blow up). A parameter 10^6 times the Table's or less than 10^-6 of it is outside.
+#: the range of each of the body's parameters (in SI units) that the book's methods serve, with
+#: absolute tolerances (1e-10 and looser) on states of order one and explicit integrators whose
+#: steps scale with the ratios c/m and c_phi/I_C (``simulate`` refuses a run whose step count
+#: these ratios would blow up)
 BODY_RANGE = (1e-6, 1e6)
 
 

@@ -96,10 +96,10 @@ def _instance(name: str, value, cls):
 
 #: explicit methods of :func:`scipy.integrate.solve_ivp` (their step is bounded by stability)
 EXPLICIT_METHODS = ("RK23", "RK45", "DOP853")
-#: the largest Lambda t_end an explicit run is allowed: the closed loop's fastest rate Lambda (1/s)
-#: times the time span; an explicit method needs at least about Lambda t_end / 4 steps (its
-#: stability region reaches about 4 along the negative real axis), so this is about 2.5e6 steps,
-#: minutes of CPU in Python
+#: the largest Lambda t_end allowed for an explicit run, Lambda (1/s) the closed loop's fastest
+#: rate and t_end the time span. An explicit method needs at least about Lambda t_end / 4 steps
+#: (its stability region reaches about 4 along the negative real axis), so this allows about
+#: 2.5e6 steps, minutes of CPU in Python
 MAX_STIFFNESS = 1e7
 
 

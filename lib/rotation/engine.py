@@ -219,11 +219,12 @@ def orbit_range(eng: _Engine, x, A, B, C, k: int, slip) -> tuple[np.ndarray, np.
     return out, mirror
 
 
-#: where the rotation's verdicts are meant to hold (issue 27): the heading's damping time I_C / c_phi
-#: is at most this many reference periods (the verdicts' transient runs 48, so a start is forgotten
-#: before the orbit search begins), and a period needs at most ``MAX_STEPS`` fixed steps (beyond, a
-#: point costs minutes: R far beyond the body's scale)
+#: the most reference periods the heading's damping time I_C / c_phi may last where the rotation's
+#: verdicts are meant to hold (their transient runs 48 periods, so a start is forgotten before the
+#: orbit search begins)
 MAX_DAMPING_PERIODS = 8.0
+#: the most fixed steps a reference period may need (beyond, a point costs minutes, R far beyond
+#: the body's scale)
 MAX_STEPS = 2 ** 14
 
 
