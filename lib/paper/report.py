@@ -35,7 +35,8 @@ from ..limits.verdicts import extend_undecided, limit_verdicts
 from ..model import f, generalized_force
 from ..params import Body, Gains
 from ..rotation.attractor import map_summary, rotation_attractor
-from ..rotation.verdicts import FIG5_GRID, fig5_map
+from ..rotation.fig5 import fig5_map
+from ..rotation.verdicts import FIG5_GRID
 from ..rotation.equations import derive_rotation_equation
 from ..simulate import OPEN_LOOP_HORIZON, Integration, open_loop_comparison, simulate
 from ..symbolic import derive_body_frame, rank_determinants
