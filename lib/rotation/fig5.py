@@ -76,7 +76,7 @@ def fig5_map(body: Body, n: int = FIG5_GRID["n"], *, confirm=("perturbed",), los
     return confirm_attractors(body, "eight", frame, confirm)
 
 
-def _redo(body, kind, frame, rows, opts, *, start=0.0, steps_factor=1):
+def _redo(body, kind, frame, rows, opts, *, start=0.0, steps_factor=1, x0=(0.0, 0.0)):
     """The decision of ``rows`` of ``frame`` taken again (the dict of
     :func:`lib.rotation.verdicts._verdict_core`), from the reference start moved by ``start``
     (relative), the verdict map's steps times ``steps_factor``; and whether each orbit found is
@@ -84,7 +84,9 @@ def _redo(body, kind, frame, rows, opts, *, start=0.0, steps_factor=1):
     :data:`ORBIT_TOL`, and it slips the same turns."""
     R, Th = frame.R.to_numpy()[rows], frame.Theta.to_numpy()[rows]
     n_pts, n_fine = frame.verdict_steps.to_numpy()[rows], frame.steps.to_numpy()[rows]
-    p0, v0 = perturbed(np.zeros((rows.size, 2)), start).T if start else np.zeros((2, rows.size))
+    x0 = np.broadcast_to(np.asarray(x0, dtype=float), (rows.size, 2))
+    # each start moved alike (the signs of one (2,) start), so that a point's decision does not depend on the batch
+    p0, v0 = (np.array([perturbed(x, start) for x in x0]) if start else x0).T.copy()
     out = _verdict_core(body, kind, R, Th, p0, v0, n_pts * steps_factor, opts, "numba", n_fine)
     k1 = frame.period.to_numpy()[rows]
     n1 = np.rint(frame.slip.to_numpy()[rows] * k1).astype(int)
@@ -102,6 +104,12 @@ def _redo(body, kind, frame, rows, opts, *, start=0.0, steps_factor=1):
     return out
 
 
+def _rows(x0, frame, rows) -> np.ndarray:
+    """The starts (M, 2) of ``rows`` from ``x0`` (2,) or (N, 2)."""
+    x0 = np.asarray(x0, dtype=float)
+    return x0 if x0.ndim == 1 else np.broadcast_to(x0, (len(frame), 2))[rows]
+
+
 def _other_orbit(regime, period, r, j) -> bool:
     """Whether decision ``r`` reaches, at row j, an orbit of the first's regime and period, but another one."""
     return regime in dv.ORBIT_REGIMES and r["regime"][j] == regime and r["period"][j] == period \
@@ -112,9 +120,11 @@ def _describe(regime, period) -> str:
     return f"{regime}, period {period}" if regime in dv.ORBIT_REGIMES else regime
 
 
-def confirm_attractors(body: Body, kind: str, frame: pd.DataFrame, confirm=("perturbed",), **options) -> pd.DataFrame:
+def confirm_attractors(body: Body, kind: str, frame: pd.DataFrame, confirm=("perturbed",), *, x0=(0.0, 0.0),
+                       **options) -> pd.DataFrame:
     """A copy of a frame of :func:`lib.rotation.verdicts.rotation_verdicts` (started on the
-    reference, its default step bounds) whose points that saw a chaotic transient
+    reference, or from ``x0`` = (p0 (rad), dp/dt(0) (rad/s)), (2,) or (N, 2); its default step
+    bounds) whose points that saw a chaotic transient
     (:func:`lib.dynamics.verdicts.needs_confirmation`: decided ``chaotic``, or an orbit reached
     after the transient) are decided again, once per key of ``confirm``
     (:data:`CONFIRMATIONS`); where the attractors reached differ
@@ -152,7 +162,7 @@ def confirm_attractors(body: Body, kind: str, frame: pd.DataFrame, confirm=("per
     if rows.size == 0 or not confirm:
         return out
     redo = [_redo(body, kind, frame, rows, opts, start=ROBUST_REL if key == "perturbed" else 0.0,
-                  steps_factor=2 if key == "steps_x2" else 1) for key in confirm]
+                  steps_factor=2 if key == "steps_x2" else 1, x0=_rows(x0, frame, rows)) for key in confirm]
     first_r, first_k = frame.regime.to_numpy()[rows], frame.period.to_numpy()[rows]
     ok = dv.attractor_determined([first_r] + [r["regime"] for r in redo], [first_k] + [r["period"] for r in redo],
                                  [r["same_orbit"] for r in redo])
@@ -169,9 +179,10 @@ def confirm_attractors(body: Body, kind: str, frame: pd.DataFrame, confirm=("per
     return out
 
 
-def confirm_lost(body: Body, kind: str, frame: pd.DataFrame, factor: int = LOST_FACTOR, **options) -> pd.DataFrame:
+def confirm_lost(body: Body, kind: str, frame: pd.DataFrame, factor: int = LOST_FACTOR, *, x0=(0.0, 0.0),
+                 **options) -> pd.DataFrame:
     """A copy of a frame of :func:`lib.rotation.verdicts.rotation_verdicts` whose headings lost
-    without a slipping orbit (a drift test over one Lyapunov run of h periods) are decided
+    without a slipping orbit (from the reference, or from ``x0`` as in :func:`confirm_attractors`; a drift test over one Lyapunov run of h periods) are decided
     again from the same start over a Lyapunov run of ``factor`` h periods, every block of it
     (no early stop): ``lost`` stays True only where the heading is lost again
     (:func:`lib.dynamics.verdicts.heading_lost`: a slipping orbit, or the drift more than 3
@@ -211,7 +222,7 @@ def confirm_lost(body: Body, kind: str, frame: pd.DataFrame, factor: int = LOST_
     for hh in np.unique(h[todo]):
         rows = todo[h[todo] == hh]
         o = dict(opts, lyapunov_periods=int(factor * hh), min_lyapunov_periods=int(factor * hh))
-        r = _redo(body, kind, frame, rows, o)
+        r = _redo(body, kind, frame, rows, o, x0=_rows(x0, frame, rows))
         idx = frame.index[rows]
         out.loc[idx, "lost"] = r["lost"]
         out.loc[idx, "slip"], out.loc[idx, "slip_stderr"] = r["slip"], r["slip_stderr"]
