@@ -377,6 +377,8 @@ def _check_fig5() -> Outcome:
                    f"fraction of Chapter 5's {n} x {n} map where the heading is lost (it slips); at most 5 % undecided",
                    f"each point decided (periodic orbits with Floquet multipliers, Lyapunov exponents, drift); "
                    f"the heading turns round (the other reading) at a fraction {m.n_turns_round / m.n_grid:.3f}; "
+                   f"chaotic at {m.n_chaotic / m.n_grid:.3f}, transient chaos (attractor not determined: a start "
+                   f"moved by 1e-12 or a longer run reaches another attractor) at {m.n_transient / m.n_grid:.4f}; "
                    "the paper's grid and criterion are not stated")
 
 
