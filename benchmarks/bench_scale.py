@@ -5,7 +5,7 @@ Run with ``make benchmark`` (or ``.venv/bin/python benchmarks/bench_scale.py``).
 Every process here runs numba on one thread (``NUMBA_NUM_THREADS=1``, set before numba
 is imported, and inherited by the spawned workers), so that "one worker" is one core.
 
-1. The cost per point as the map grows: :func:`lib.rotation.verdicts.fig5_map` on the
+1. The cost per point as the map grows: :func:`lib.rotation.fig5.fig5_map` on the
    n x n grid for n in ``--sizes`` (100, 200, 300), in this process, after a warm-up
    call that loads the compiled kernels. The cost is linear in the points when the time
    per point stays flat.
@@ -32,7 +32,7 @@ import pandas as pd  # noqa: E402
 
 from lib.params import Body  # noqa: E402
 from lib.machinery.parallel import process_pool  # noqa: E402
-from lib.rotation.verdicts import fig5_map  # noqa: E402
+from lib.rotation.fig5 import fig5_map  # noqa: E402
 
 
 @contextmanager

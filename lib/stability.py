@@ -18,7 +18,8 @@ from .rotation.circle_global import circle_final_state, circle_slipping_coexists
 from .rotation.reduced import ENGINES, reduced_rotation, rotation_sweep, steps_per_period
 from .dynamics.sampled import classify_samples, sampled_range
 from .rotation.attractor import MapSummary, RotationAttractor, map_summary, rotation_attractor
-from .rotation.verdicts import FIG5_GRID, REGIMES, eight_rotation_sweep, fig5_map, rotation_verdicts
+from .rotation.verdicts import FIG5_GRID, REGIMES, eight_rotation_sweep, rotation_verdicts
+from .rotation.fig5 import fig5_map
 from .rotation.equations import (RotationEquation, corrected_p0, derive_eight_equation,
                                  derive_rotation_equation, printed_eq33, printed_eq37, printed_p0)
 from .trajectories import PAPER_HEADING_SERIES, eight_heading_fourier, heading_series

@@ -24,7 +24,7 @@ DOCUMENTED = [
     "allocation.Limits", "allocation.allocate", "allocation.allocate_least_squares", "allocation.allocate_limited",
     "control.computed_torque", "control.demand", "simulate.simulate", "symbolic.lie_bracket",
     "closed_loop.ClosedLoop.of", "rotation.verdicts.rotation_verdicts", "rotation.verdicts.eight_rotation_sweep",
-    "rotation.verdicts.fig5_map", "limits.verdicts.limit_verdicts", "limits.sections.sweep_angle_limit",
+    "rotation.fig5.fig5_map", "limits.verdicts.limit_verdicts", "limits.sections.sweep_angle_limit",
     "weighting.verdicts.closed_loop_verdicts", "weighting.comparison.verdict_runs", "tracking.runs.run",
     "tracking.runs.eight_sensitivity", "tracking.runs.force_cap_sweep", "machinery.parallel.map_chunks",
     "machinery.parallel.map_in_processes", "machinery.parallel.show_progress", "machinery.checks.number",

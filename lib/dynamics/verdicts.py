@@ -19,6 +19,12 @@ The words (the book's definition ``def-regimes``, on its Methods page):
 ``chaotic``
     no orbit is reached and the largest Lyapunov exponent per period, lambda T,
     exceeds both ``sigmas`` (3) standard errors and the band (:func:`classify`).
+``transient`` (transient chaos: attractor not determined)
+    the point's run was decided again (:func:`needs_confirmation` says which runs are) from
+    the same start at another integration resolution or from the start moved by 1e-12, or
+    over a longer horizon, and the attractors reached differ: another regime, another period,
+    or another orbit (:func:`attractor_determined`). The run wanders irregularly for a while
+    and which attractor it then settles on is decided by the last bits of the trajectory.
 ``quasiperiodic``
     no orbit, lambda T within the band of zero with SE <= band / 3, and the section
     closes on itself (:func:`section_returns`).
@@ -55,10 +61,16 @@ from .statistics import batch_means, block_statistics, drift_statistics, section
 
 __all__ = ["REGIMES", "SIGMAS", "PeriodMap", "lag_candidates", "difference_jacobian", "newton", "NewtonResult", "least_period",
            "distance_to_orbit", "reached", "block_statistics", "batch_means", "drift_statistics", "section_returns", "classify",
-           "heading_lost", "turns_round", "held", "redecide_undecided", "orbit_regime", "orbit_points", "find_orbits", "enclosed_orbit"]
+           "heading_lost", "turns_round", "held", "TRANSIENT", "needs_confirmation", "attractor_determined", "redecide_undecided", "orbit_regime", "orbit_points", "find_orbits", "enclosed_orbit"]
 
 #: the verdicts, in the order the book lists them
-REGIMES = ("periodic", "slipping", "chaotic", "quasiperiodic", "undecided")
+REGIMES = ("periodic", "slipping", "chaotic", "transient", "quasiperiodic", "undecided")
+
+#: the regime of a point whose decisions reach different attractors (transient chaos)
+TRANSIENT = "transient"
+
+#: the regimes of an attracting orbit reached
+ORBIT_REGIMES = ("periodic", "slipping")
 
 #: standard errors by which a positive exponent must clear zero to be called chaotic
 SIGMAS = 3.0
@@ -106,6 +118,59 @@ def classify(lam_T, se_T, returns, *, band: float, return_tol: float, max_period
                        "(no closed curve: a slow transient or a bifurcation)",
                  "Lyapunov exponent not resolved from zero"))).astype(object)
     return regime, reason
+
+
+def needs_confirmation(regime, periods, transient: int) -> np.ndarray:
+    """The trigger for deciding a run again (:func:`attractor_determined`): its first
+    decision saw a chaotic transient, that is, it reached no attracting orbit within the
+    ``transient`` periods and went on to the Lyapunov run, and was then decided ``chaotic``
+    or reached its orbit there (``periods`` > ``transient``: an orbit reached late).
+    Orbits reached within the transient, and quasi-periodic and undecided runs, are not
+    decided again. Returns (N,) bool.
+
+    Parameters
+    ----------
+    regime : array_like
+        First verdicts (N,).
+    periods : array_like
+        Periods integrated before each verdict (N,).
+    transient : int
+        The transient's periods.
+
+    Returns
+    -------
+    numpy.ndarray
+        (N,) bool.
+    """
+    regime, periods = np.asarray(regime, dtype=object), np.asarray(periods)
+    return (regime == "chaotic") | (np.isin(regime, ORBIT_REGIMES) & (periods > transient))
+
+
+def attractor_determined(regime, period, same_orbit) -> np.ndarray:
+    """The rule of ``transient``: whether D decisions of the same N runs (the first one the
+    map's, the others from a perturbed start, at another resolution or over a longer horizon)
+    reach the same attractor: the same regime, the same period, and, where the first reaches
+    an orbit, the same orbit (``same_orbit``, decided by the flow: the orbits' points agree
+    within its accuracy). Returns (N,) bool; where False the verdict is ``transient``.
+
+    Parameters
+    ----------
+    regime, period : array_like
+        Verdicts and periods (D, N), the first row the map's.
+    same_orbit : array_like
+        (D - 1, N) bool: decision j + 1 reached the first decision's orbit (read only where
+        both reach an orbit of the same period).
+
+    Returns
+    -------
+    numpy.ndarray
+        (N,) bool.
+    """
+    regime, period = np.atleast_2d(np.asarray(regime, dtype=object)), np.atleast_2d(np.asarray(period))
+    same = (regime[1:] == regime[0]) & (period[1:] == period[0])
+    orbit = np.isin(regime[0], ORBIT_REGIMES)
+    same &= ~orbit | np.atleast_2d(np.asarray(same_orbit, dtype=bool))
+    return same.all(axis=0)
 
 
 def held(regime, lost, tracked=True) -> np.ndarray:

@@ -25,7 +25,7 @@ __all__ = ["body_outline", "draw_body", "new_axes", "plot_path", "plot_errors", 
 
 
 #: how each non-periodic regime of :func:`lib.rotation.verdicts.rotation_verdicts` is drawn on the maps
-REGIME_COLORS = {"slipping": "C3", "chaotic": "0.15", "quasiperiodic": "C0", "undecided": "0.7"}
+REGIME_COLORS = {"slipping": "C3", "chaotic": "0.15", "transient": "C1", "quasiperiodic": "C0", "undecided": "0.7"}
 
 
 def _grid(frame: pd.DataFrame, column: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

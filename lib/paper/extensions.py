@@ -22,7 +22,7 @@ from ..limits.attractors import (heading_offset_starts, lyapunov_horizons, mirro
 from ..tracking.mismatch import mismatch_study
 from ..percussion import circle_lock_radius, circle_steady_motion, percussion_fig5_map
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
-from ..rotation.verdicts import fig5_map
+from ..rotation.fig5 import fig5_map
 from ..rotation.slow_eight import slow_eight_prediction
 from ..trajectories import eight
 from ..weighting.circle import circle_steady_state, circle_weight_limit

@@ -41,7 +41,8 @@ from ..limits.verdicts import extend_undecided, limit_verdicts
 from ..model import f, generalized_force
 from ..params import Body, Gains
 from ..rotation.attractor import map_summary, rotation_attractor
-from ..rotation.verdicts import FIG5_GRID, fig5_map
+from ..rotation.fig5 import fig5_map
+from ..rotation.verdicts import FIG5_GRID
 from ..rotation.equations import derive_rotation_equation
 from ..simulate import OPEN_LOOP_HORIZON, Integration, open_loop_comparison, simulate
 from ..symbolic import derive_body_frame, rank_determinants
@@ -412,6 +413,8 @@ def _check_fig5() -> Outcome:
                    f"fraction of Chapter 5's {n} x {n} map where the heading is lost (it slips); at most 5 % undecided",
                    f"each point decided (periodic orbits with Floquet multipliers, Lyapunov exponents, drift); "
                    f"the heading turns round (the other reading) at a fraction {m.n_turns_round / m.n_grid:.3f}; "
+                   f"chaotic at {m.n_chaotic / m.n_grid:.3f}, transient chaos (attractor not determined: a start "
+                   f"moved by 1e-12 or a longer run reaches another attractor) at {m.n_transient / m.n_grid:.4f}; "
                    "the paper's grid and criterion are not stated")
 
 

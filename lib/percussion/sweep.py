@@ -100,7 +100,7 @@ def rotation_sweep(body: Body, R, Theta, *, kind: str = "eight", p0=0.0, executo
 def percussion_fig5_map(body: Body, R_range=FIG5_GRID["R"], Theta_range=FIG5_GRID["Theta"],
                         n: int = FIG5_GRID["n"], **kw) -> pd.DataFrame:
     """:func:`rotation_sweep` on the n x n grid of Fig. 5 (Theta varying slowest), as
-    :func:`lib.rotation.verdicts.fig5_map` lays it out.
+    :func:`lib.rotation.fig5.fig5_map` lays it out.
 
     Parameters
     ----------

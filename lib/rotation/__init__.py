@@ -7,7 +7,9 @@
 * :mod:`.reduced`: the reduced rotation over many (R, Theta): integration, period map,
   orbits, Lyapunov exponents;
 * :mod:`.engine`: the reduced rotation as a period map for the verdicts (compiled, exact Jacobian);
-* :mod:`.verdicts`: the decisive Fig. 5 verdicts, ``eight_rotation_sweep``, ``fig5_map``;
+* :mod:`.verdicts`: the decisive Fig. 5 verdicts, ``eight_rotation_sweep``;
+* :mod:`.fig5`: the book's Fig. 5 map, ``fig5_map``: verdicts that a chaotic transient may have
+  decided taken again (transient chaos), lost headings tested over a longer horizon;
 * :mod:`.attractor`: the attracting orbit one start reaches; a map's summary;
 * :mod:`.slow_eight`: slow eights without integrating (the frozen and overdamped heading).
 

@@ -152,9 +152,10 @@ class MapSummary:
     """What a map of verdicts (:func:`lib.rotation.verdicts.rotation_verdicts`) shows, for the book to quote.
 
     Counts: ``n_grid`` points; ``n_periodic``, ``n_slipping``, ``n_chaotic``,
-    ``n_quasiperiodic``, ``n_undecided`` per regime; ``n_lost`` where the heading is lost
+    ``n_transient`` (transient chaos: attractor not determined), ``n_quasiperiodic``, ``n_undecided`` per regime; ``n_lost`` where the heading is lost
     (column ``lost``: it slips), of them ``n_lost_slipping`` on a slipping orbit and
-    ``n_lost_no_orbit`` without an orbit (drifting); ``n_turns_round`` the count under the
+    ``n_lost_no_orbit`` without an orbit (drifting) and ``n_lost_transient`` lost on the run from
+    the reference whose attractor is not determined (``transient``); ``n_turns_round`` the count under the
     other reading (column ``turns_round``: the range of p exceeds a full turn), of them
     ``n_turns_round_periodic`` on periodic orbits and ``n_turns_round_chaotic`` chaotic;
     ``n_chaotic_within_turn`` chaotic points whose heading stays within one turn, ``chaotic_range_median`` (rad) the median range of the chaotic points;
@@ -173,11 +174,13 @@ class MapSummary:
     n_periodic: int
     n_slipping: int
     n_chaotic: int
+    n_transient: int
     n_quasiperiodic: int
     n_undecided: int
     n_lost: int
     n_lost_slipping: int
     n_lost_no_orbit: int
+    n_lost_transient: int
     n_turns_round: int
     n_turns_round_periodic: int
     n_turns_round_chaotic: int
@@ -233,7 +236,8 @@ def map_summary(frame: pd.DataFrame) -> MapSummary:
     return MapSummary(
         n_grid=len(frame), **{f"n_{r}": int((reg == r).sum()) for r in REGIMES},
         n_lost=int(frame.lost.sum()), n_lost_slipping=int((frame.lost & (reg == "slipping")).sum()),
-        n_lost_no_orbit=int((frame.lost & (reg != "slipping")).sum()),
+        n_lost_no_orbit=int((frame.lost & ~reg.isin(["slipping", "transient"])).sum()),
+        n_lost_transient=int((frame.lost & (reg == "transient")).sum()),
         n_turns_round=int(frame.turns_round.sum()),
         n_turns_round_periodic=int((frame.turns_round & (reg == "periodic")).sum()),
         n_turns_round_chaotic=int((frame.turns_round & (reg == "chaotic")).sum()),

@@ -7,7 +7,9 @@ This module holds the schedule that makes the Fig. 5 map take seconds: points ru
 together on the compiled period map (:mod:`lib.rotation.engine`) and leave as soon as
 they are decided, Newton tried on the way during a short transient and again during
 the Lyapunov run. The one-point view (the attracting orbit a start reaches) and the
-map's summary are in :mod:`lib.rotation.attractor`.
+map's summary are in :mod:`lib.rotation.attractor`; the book's Fig. 5 map, its verdicts
+decided again where the last bits may decide them (transient chaos), is in
+:mod:`lib.rotation.fig5`.
 
 Units: R in m, Theta in rad/s, angles in rad, the phase s in rad; w = d phi / ds.
 """
@@ -30,7 +32,7 @@ from .engine import RotationMap, _Engine, check_domain, orbit_range, verdict_ste
 from .field import coefficients
 
 __all__ = ["REGIMES", "VERDICT_DEFAULTS", "SLOW_FLOQUET", "verdict_steps", "section_returns", "rotation_verdicts",
-           "eight_rotation_sweep", "FIG5_GRID", "fig5_map"]
+           "eight_rotation_sweep", "FIG5_GRID"]
 
 #: the verdicts of :func:`rotation_verdicts` (defined in :mod:`lib.dynamics.verdicts`)
 REGIMES = dv.REGIMES
@@ -61,33 +63,8 @@ def eight_rotation_sweep(body: Body, R, Theta, **options) -> pd.DataFrame:
     return rotation_verdicts(body, "eight", R, Theta, **options)
 
 
-#: The book's Fig. 5 grid of n x n points, R evenly in ``R`` (m) and Theta evenly in ``Theta`` (rad/s).
+#: The book's Fig. 5 grid (:func:`lib.rotation.fig5.fig5_map`) of n x n points, R evenly in ``R`` (m) and Theta evenly in ``Theta`` (rad/s).
 FIG5_GRID = MappingProxyType(dict(R=(0.25, 4.0), Theta=(0.05, 1.5), n=100))
-
-
-def fig5_map(body: Body, n: int = FIG5_GRID["n"], *, executor=None, chunk_size: int | None = None,
-             progress: bool | None = None) -> pd.DataFrame:
-    """The book's Fig. 5 (Chapter 5, and the report's row on it): :func:`eight_rotation_sweep`
-    on the n x n grid :data:`FIG5_GRID`, Theta varying slowest.
-
-    Parameters
-    ----------
-    body : Body
-        The body.
-    n : int
-        Points per side (>= 2).
-    executor, chunk_size, progress
-        As in :func:`rotation_verdicts`.
-
-    Returns
-    -------
-    pandas.DataFrame
-        The frame of :func:`rotation_verdicts`, n^2 rows.
-    """
-    n = checks.integer("n", n, minimum=2)
-    R, Th = np.meshgrid(np.linspace(*FIG5_GRID["R"], n), np.linspace(*FIG5_GRID["Theta"], n))
-    return eight_rotation_sweep(body, R.ravel(), Th.ravel(), executor=executor, chunk_size=chunk_size,
-                                progress=progress)
 
 
 def _check_body_kind(body, kind):
