@@ -27,7 +27,7 @@ def test_sympy_point_is_minus_inertia_over_m_a_and_matches_numbers():
     d = pc.derive_point()
     S = d.sym
     assert sp.simplify(d.s_P + S["I"] / (S["m"] * S["a"])) == 0
-    assert pc.centre_of_percussion(BODY) == pytest.approx(-BODY.I / (BODY.m * BODY.a), rel=1e-15)
+    assert pc.centre_of_percussion(BODY) == pytest.approx(-BODY.I / (BODY.m * BODY.a), rel=1e-15)  # exact: the same closed form, one division
     assert sp.simplify(d.lateral_u2.subs(S["s"], d.s_P)) == 0
 
 
@@ -43,7 +43,7 @@ def test_point_acceleration_is_free_of_the_lateral_force_in_lib_model():
         e2 = np.stack([-e1[:, 1], e1[:, 0]], -1)
         aP = ddz[:, :2] + s * ddz[:, 2:3] * e2 - s * dz[:, 2:3] ** 2 * e1
         _, dP = pc.point_state(BODY, z, dz)
-        np.testing.assert_allclose(pc.point_accel(BODY, z[:, 2], dz[:, 2], dP, u1), aP, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(pc.point_accel(BODY, z[:, 2], dz[:, 2], dP, u1), aP, rtol=1e-12, atol=1e-12)  # exact: two algebraic forms of one expression, O(1) terms
 
 
 def test_sympy_equation_of_P_matches_the_numeric_form():
@@ -56,7 +56,7 @@ def test_sympy_equation_of_P_matches_the_numeric_form():
     for i in range(10):
         got = np.array(f(z[i, 2], dz[i, 2], dz[i, 0], dz[i, 1], F[i] * np.cos(beta[i])), float).ravel()
         want = pc.point_accel(BODY, z[i, 2], dz[i, 2], dP[i], F[i] * np.cos(beta[i]))
-        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)  # exact: sympy's expression against numpy's
 
 
 def test_lateral_drag_vanishes_exactly_when_the_drag_rates_agree():
@@ -65,8 +65,8 @@ def test_lateral_drag_vanishes_exactly_when_the_drag_rates_agree():
     equal = {S["c"]: S["m"] * S["c_phi"] / S["I"]}
     assert sp.simplify(d.drag_lateral.subs(equal)) == 0
     assert sp.simplify(d.drag_lateral - d.s_P * d.mismatch * S["omega"]) == 0
-    assert pc.drag_mismatch(BODY) == pytest.approx(0.3 - 1.0)
-    assert pc.lateral_drag_speed(BODY) == pytest.approx((BODY.c_phi * BODY.m - BODY.c * BODY.I) / (BODY.m**2 * BODY.a))
+    assert pc.drag_mismatch(BODY) == pytest.approx(0.3 - 1.0)  # exact: c/m - c_phi/I_C of the Table
+    assert pc.lateral_drag_speed(BODY) == pytest.approx((BODY.c_phi * BODY.m - BODY.c * BODY.I) / (BODY.m**2 * BODY.a))  # exact: closed form
 
 
 def test_static_feedback_is_singular_and_the_extension_regular_iff_drag_rates_differ():
@@ -84,10 +84,10 @@ def test_circle_steady_motion_matches_the_full_closed_loop():
     st = pc.circle_steady_motion(BODY, R, Th)
     # integration at rtol 1e-10 over 60 s; the transient has decayed by exp(-0.8 * 50)
     p = wrap_angle(res.z[:, 2] - ref.z(res.t)[:, 2])
-    np.testing.assert_allclose(p, st.p, atol=1e-7)
-    np.testing.assert_allclose(res.F, st.F, rtol=1e-7)
-    np.testing.assert_allclose(np.hypot(res.z[:, 0], res.z[:, 1]), st.radius_C, rtol=1e-7)
-    np.testing.assert_allclose(res.beta, st.beta, atol=1e-7)
+    np.testing.assert_allclose(p, st.p, atol=1e-7)  # accuracy: 1000 x rtol 1e-10 over 60 s
+    np.testing.assert_allclose(res.F, st.F, rtol=1e-7)  # accuracy: 1000 x rtol 1e-10
+    np.testing.assert_allclose(np.hypot(res.z[:, 0], res.z[:, 1]), st.radius_C, rtol=1e-7)  # accuracy: 1000 x rtol 1e-10
+    np.testing.assert_allclose(res.beta, st.beta, atol=1e-7)  # accuracy: 1000 x rtol 1e-10
 
 
 def test_circle_rate_is_the_decay_of_the_zero_dynamics():
@@ -99,7 +99,7 @@ def test_circle_rate_is_the_decay_of_the_zero_dynamics():
     phi = pc.zero_dynamics_run(BODY, ref, t, math.pi / 2 + st.p + d0)
     d1 = phi[-1] - (Th * t[-1] + math.pi / 2 + st.p)
     # linearisation error O(d0) relative; integration at rtol 1e-11
-    assert math.log(d1 / d0) / t[-1] == pytest.approx(st.rate, rel=1e-3)
+    assert math.log(d1 / d0) / t[-1] == pytest.approx(st.rate, rel=1e-3)  # reason: the linearisation's error, O(d0 = 1e-5) relative, and 1e-11 integration
 
 
 def test_below_the_lock_radius_the_heading_slips():
@@ -120,7 +120,7 @@ def test_lock_radius_is_below_the_papers_critical_radius():
     for Th in (0.1, 0.5, 1.5):
         ours, paper = pc.circle_lock_radius(BODY, Th), circle_equilibria.circle_critical_radius(BODY, Th)
         factor = BODY.c_phi / (BODY.c_phi - BODY.c * BODY.I / BODY.m)
-        assert paper == pytest.approx(ours * factor, rel=1e-12)
+        assert paper == pytest.approx(ours * factor, rel=1e-12)  # exact: two closed forms
 
 
 def test_point_error_follows_the_designed_third_order_equation():
@@ -133,15 +133,15 @@ def test_point_error_follows_the_designed_third_order_equation():
         x0 = np.array([e[0, j], de[0, j], dde[0, j]])
         want = np.array([expm(A * t) @ x0 for t in res.t])
         # DOP853 at rtol = atol = 1e-10 on errors of order 1 m
-        np.testing.assert_allclose(e[:, j], want[:, 0], atol=1e-7)
-        np.testing.assert_allclose(de[:, j], want[:, 1], atol=1e-7)
+        np.testing.assert_allclose(e[:, j], want[:, 0], atol=1e-7)  # accuracy: 1000 x the integration's 1e-10
+        np.testing.assert_allclose(de[:, j], want[:, 1], atol=1e-7)  # accuracy: 1000 x the integration's 1e-10
 
 
 def test_error_polynomial_is_the_papers_24_times_one_pole():
     k = pc.error_polynomial(BODY, GAINS, pole=3.0)
     roots = np.sort_complex(np.roots([1, *k[0]]))
     paper = np.roots([BODY.m, GAINS.kv[0], GAINS.kp[0]])
-    np.testing.assert_allclose(np.sort_complex(np.r_[paper, -3.0]), roots, rtol=1e-10)
+    np.testing.assert_allclose(np.sort_complex(np.r_[paper, -3.0]), roots, rtol=1e-10)  # accuracy: np.roots on a cubic, well-separated roots
 
 
 def test_law_meets_the_papers_steady_circle_when_P_is_given_the_papers_P_circle():
@@ -151,12 +151,12 @@ def test_law_meets_the_papers_steady_circle_when_P_is_given_the_papers_P_circle(
     # under the paper's law C runs on R with heading p0: P runs on this circle
     R_P = math.sqrt(R**2 - 2 * R * s * math.sin(p0) + s**2)
     st = pc.circle_steady_motion(BODY, R_P, Th)
-    assert st.radius_C == pytest.approx(R, rel=1e-12)
-    assert st.F == pytest.approx(R * Th * math.hypot(BODY.m * Th, BODY.c), rel=1e-12)
+    assert st.radius_C == pytest.approx(R, rel=1e-12)  # exact: closed forms composed
+    assert st.F == pytest.approx(R * Th * math.hypot(BODY.m * Th, BODY.c), rel=1e-12)  # exact: closed forms
     # and the paper's law, simulated, puts P on that circle
     res = paper_simulate(BODY, GAINS, tr.circle(R, Th), 80.0, t_eval=np.linspace(70, 80, 5))
     P, _ = pc.point_state(BODY, res.z, res.dz)
-    np.testing.assert_allclose(np.hypot(P[:, 0], P[:, 1]), R_P, rtol=1e-7)
+    np.testing.assert_allclose(np.hypot(P[:, 0], P[:, 1]), R_P, rtol=1e-7)  # accuracy: 1000 x rtol 1e-10 over 80 s
 
 
 @pytest.mark.parametrize("call, name", [

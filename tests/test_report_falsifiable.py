@@ -178,6 +178,33 @@ def test_weight_limit_row_fails_with_each_clause(monkeypatch, w, below, above, s
                    circle_steady_state=steady) == status
 
 
+# ------------------------------------------------------------------ percussion: the circle and the map
+
+@pytest.mark.parametrize("radius_gap, lock, rate, status", [
+    (0.0, 0.10, -15.0, "extended"),
+    (1e-6, 0.10, -15.0, "not reproducible"),       # C's closed-form circle is not the paper's R
+    (0.0, 0.20, -15.0, "not reproducible"),        # the lock radius above the paper's (36)
+    (0.0, 0.10, 0.5, "not reproducible"),          # the heading's rate not negative
+])
+def test_percussion_circle_row_fails_with_each_clause(monkeypatch, radius_gap, lock, rate, status):
+    steady = lambda body, R, Theta: SimpleNamespace(radius_C=ext.R0 * (1 + radius_gap), rate=rate)  # noqa: E731
+    assert _status(monkeypatch, "percussion-circle", circle_equilibria=lambda body, R, th: (1.15, 4.3),
+                   circle_steady_motion=steady, circle_lock_radius=lambda body, th: lock,
+                   circle_critical_radius=lambda body, th: 0.15) == status
+
+
+@pytest.mark.parametrize("regime, lost, status", [
+    ("periodic", False, "extended"),
+    ("chaotic", False, "not reproducible"),        # one chaotic point
+    ("periodic", True, "not reproducible"),        # one point lost
+    ("transient", False, "not reproducible"),      # one point not held
+])
+def test_percussion_map_row_fails_with_one_point_not_held(monkeypatch, regime, lost, status):
+    fr = pd.DataFrame({"regime": ["periodic"] * 9 + [regime], "lost": [False] * 9 + [lost]})
+    assert _status(monkeypatch, "percussion-map", cached=_cache(percussion_fig5_map=fr)) == status
+
+
 def test_every_extension_row_has_a_falsifying_test():
-    tested = {"limit-lyapunov", "limit-mirror", "wrong-model", "slow-eights", "window", "weight-limit"}
+    tested = {"limit-lyapunov", "limit-mirror", "wrong-model", "slow-eights", "window", "weight-limit",
+              "percussion-circle", "percussion-map"}
     assert set(ITEMS) == tested

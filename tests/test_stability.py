@@ -142,7 +142,7 @@ def test_classification_on_constructed_cases():
     assert c["range"][0] == pytest.approx(0.6, abs=1e-14)  # exact: max - min of constructed samples; measured 0
 
 
-@pytest.mark.parametrize("R, Th", [([-1.0], [0.5]), ([1.0], [0.0]), ([], []), ([1.0, 2.0], [0.5]),
+@pytest.mark.parametrize("R, Th", [([-1.0], [0.5]), ([1.0], [0.0]), ([], []), ([1.0, 2.0], [0.5, 1.0, 1.5]),
                                    ([[1.0]], [[0.5]]), ([np.nan], [0.5])])
 def test_sweep_rejects_bad_input(R, Th):
     with pytest.raises(ValueError):
