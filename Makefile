@@ -13,12 +13,15 @@ $(STAMP): requirements.txt pyproject.toml
 	$(BIN)/python -m pip install --quiet -r requirements.txt
 	touch $(STAMP)
 
+# The pages are executed two at a time into the execution cache (tools/preexecute.py, which
+# empties it first), then the build reads their outputs from it (_config.yml: execute).
 # The build's output goes to the terminal and to _build/build.log (its time set back to when
 # the build began), its exit status to _build/build.rc: `make test` reuses a build that is
 # current and reads its warnings from that log (tests/conftest.py, fixture built_book).
 book: $(STAMP)
 	mkdir -p _build && rm -f _build/build.rc && touch _build/build.start
-	{ PYTHONWARNINGS=default $(BIN)/jupyter-book build --all -W -n --keep-going . 2>&1; \
+	{ PYTHONWARNINGS=default $(BIN)/python tools/preexecute.py 2>&1 && \
+	  PYTHONWARNINGS=default $(BIN)/jupyter-book build --all -W -n --keep-going . 2>&1; \
 	  echo $$? > _build/build.rc; } | tee _build/build.log
 	touch -r _build/build.start _build/build.log
 	@test "$$(cat _build/build.rc)" = 0 || { echo "Book build failed (see _build/build.log)"; exit 1; }

@@ -2,8 +2,8 @@
 
 Run with ``make book-times`` (or ``.venv/bin/python benchmarks/book_times.py [page ...]``, pages
 as in ``_toc.yml``: ``chapters/04_limits``, ``report``). Each page that is a notebook is read
-with jupytext and executed with nbclient, one after another in the order of ``_toc.yml``, as
-the book's build executes them: in a fresh copy of the book's sources in a temporary folder,
+with jupytext and executed with nbclient, one after another in the order in which the book's
+build executes them (sorted by name, as Sphinx reads its pages): in a fresh copy of the book's sources in a temporary folder,
 so that nothing computed by an earlier build is reused (the report and the errata still read
 what the chapters before them cached in that copy, as in a build).
 
@@ -125,8 +125,9 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory(prefix="book-times-") as tmp:
         book = Path(tmp)
         copy_book(book)
-        # the page order of the build: the report and the errata read what the chapters cached
-        order = [p for p in toc_pages() if p in pages] + [p for p in pages if p not in toc_pages()]
+        # the order of the build (Sphinx reads its pages sorted by name): the chapters, then the
+        # errata and the report, which read what the chapters cached
+        order = sorted(pages)
         for page in order:
             md = book / f"{page}.md"
             if not is_notebook(md):
