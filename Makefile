@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: book test benchmark clean mutation
+.PHONY: book test benchmark book-times clean mutation
 
 $(STAMP): requirements.txt pyproject.toml
 	@echo "Installing .venv from requirements.txt and pyproject.toml (a few minutes the first time)..."
@@ -49,6 +49,13 @@ benchmark: $(STAMP)
 	$(BIN)/python benchmarks/bench_switched.py
 	$(BIN)/python benchmarks/bench_eight_sweep.py
 	$(BIN)/python benchmarks/bench_scale.py
+	$(BIN)/python benchmarks/bench_book.py
+
+# Where the book's build time goes: each page's and each heavy cell's wall and CPU time, the pages
+# executed one after another in a fresh copy of the book (benchmarks/book_times.py).
+# PAGES="chapters/04_limits report" for some; MIN=0.5 lists the cells above 0.5 s.
+book-times: $(STAMP)
+	$(BIN)/python benchmarks/book_times.py --min $(or $(MIN),1) $(PAGES)
 
 clean:
 	rm -rf _build

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import shutil
 import sys
 import time
@@ -61,13 +62,21 @@ def read_page(md: Path, root: Path = ROOT):
 
 
 def _execute(md: str, root: str, timeout: int, allow_errors: bool):
-    """Execute one page in its folder (in a worker process); the notebook, error text, time."""
+    """Execute one page in its folder (in a worker process); the notebook, the error's text,
+    the wall time and the kernel's CPU time (s)."""
     from jupyter_cache.executors.utils import single_nb_execution
 
     nb = read_page(Path(md), Path(root))
+    cpu = _children_cpu()
     res = single_nb_execution(nb, cwd=str(Path(md).parent), timeout=timeout, allow_errors=allow_errors,
                               meta_override=True)
-    return nb, (res.exc_string if res.err is not None else None), res.time
+    # the kernel, a child of this worker, has ended and been waited for: its CPU time
+    return nb, (res.exc_string if res.err is not None else None), res.time, _children_cpu() - cpu
+
+
+def _children_cpu() -> float:
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
 
 
 def order(pages: list[str]) -> list[str]:
@@ -101,7 +110,7 @@ def main(argv: list[str] | None = None) -> int:
         jobs = {pool.submit(_execute, str(root / f"{p}.md"), str(root), timeout, allow): p for p in pages}
         for fut in as_completed(jobs):
             page = jobs[fut]
-            nb, err, seconds = fut.result()
+            nb, err, seconds, cpu = fut.result()
             if err is not None:
                 failed.append(page)
                 print(f"  {page}: FAILED after {seconds:.1f} s\n{err}", flush=True)
@@ -110,7 +119,7 @@ def main(argv: list[str] | None = None) -> int:
             record = cache.add_nb_to_project(str(md), read_data={"type": "plugin", "name": "myst_nb_md"})
             cache.cache_notebook_bundle(CacheBundleIn(nb, record.uri, data={"execution_seconds": seconds}),
                                         check_validity=False, overwrite=True)
-            print(f"  {page}: {seconds:.1f} s", flush=True)
+            print(f"  {page}: {seconds:.1f} s ({cpu:.1f} s of CPU)", flush=True)
     print(f"Executed in {time.perf_counter() - tic:.1f} s" + (f"; failed: {', '.join(failed)}" if failed else ""),
           flush=True)
     return 1 if failed else 0
