@@ -33,9 +33,9 @@ R0, THETA0 = 2.0, math.pi / 4
 
 def _check_window() -> Outcome:
     body = Body()
-    rc, re = bistable_window(body, THETA0)
+    rc, re = cached(bistable_window, body, THETA0)                 # Chapter 5's calls
     width = re / rc - 1.0
-    th = window_closing_rate(body)
+    th = cached(window_closing_rate, body)
     # where the window closes, the normalised damping is the damped pendulum's threshold
     gap = abs(math.sqrt(body.c_phi / (body.I * th)) / torque_pendulum_threshold() - 1.0)
     ok = 0.0 < width < 0.01 and th < THETA0 and gap < 1e-6    # measured: 0.0045, 0.70 rad/s, rounding
