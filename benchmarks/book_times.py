@@ -115,6 +115,8 @@ def _first_line(src: str) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
+    # the kernels' environment of the build (tools/preexecute.py: BLAS single-threaded)
+    os.environ["OPENBLAS_NUM_THREADS"] = "1"
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("pages", nargs="*", help="pages of _toc.yml (default: every notebook page, in its order)")
     ap.add_argument("--min", type=float, default=1.0, help="list cells above this CPU or wall time (s)")

@@ -9,7 +9,8 @@ that follows then finds every page's outputs there instead of executing it. Each
 myst-nb's own reader and the build's MyST configuration, so its cache key (the code cells and
 their metadata) is the one the build looks up; a page it misses is executed by the build itself.
 
-Nothing from an earlier build is reused: the cache is emptied first, and a page that fails stops
+The kernels run with BLAS single-threaded (:data:`KERNEL_ENV`). Nothing from an earlier build is
+reused: the cache is emptied first, and a page that fails stops
 the script with its traceback (the build is then not run). Pages that read other pages' results
 (``LAST``: the report and the errata read the chapters' through :mod:`lib.book_cache`) start
 last; the others start longest first (``COST``, measured by ``benchmarks/book_times.py``).
@@ -32,6 +33,11 @@ import yaml
 ROOT = Path(__file__).resolve().parents[1]
 #: pages that read what other pages cached: started after the others
 LAST = ("errata", "report")
+#: the kernels' environment: BLAS single-threaded. The book's matrices are small (2 x 2 to
+#: 6 x 6, stacks of them), so OpenBLAS's threads only spin: measured, Chapter 3's check of (24)
+#: (scipy's expm on a stack of 2 x 2 matrices) took 0.72 s of CPU with them and 0.08 s without,
+#: on a loaded machine. numba keeps its threads (its kernels are the pages' heavy work).
+KERNEL_ENV = {"OPENBLAS_NUM_THREADS": "1"}
 #: a page's CPU time (s), measured, to start the longest first (unknown pages first of all)
 COST = {"chapters/04_limits": 170, "chapters/05_stability": 120, "chapters/06_allocation": 80,
         "chapters/03_tracking": 50, "chapters/02_controllability": 12, "chapters/01_model": 3}
@@ -97,6 +103,7 @@ def main(argv: list[str] | None = None) -> int:
     from jupyter_cache.base import CacheBundleIn
 
     root = args.root.resolve()
+    os.environ.update(KERNEL_ENV)                         # inherited by the workers' kernels
     execute = _config(root).get("execute", {})
     path = root / execute.get("cache", "_build/.jupyter_cache")
     shutil.rmtree(path, ignore_errors=True)               # nothing from an earlier build
