@@ -39,8 +39,8 @@ LAST = ("errata", "report")
 #: on a loaded machine. numba keeps its threads (its kernels are the pages' heavy work).
 KERNEL_ENV = {"OPENBLAS_NUM_THREADS": "1"}
 #: a page's CPU time (s), measured, to start the longest first (unknown pages first of all)
-COST = {"chapters/04_limits": 170, "chapters/05_stability": 120, "chapters/06_allocation": 80,
-        "chapters/03_tracking": 50, "chapters/02_controllability": 12, "chapters/01_model": 3}
+COST = {"chapters/04_limits": 166, "chapters/05_stability": 100, "chapters/03_tracking": 52,
+        "chapters/06_allocation": 33, "chapters/02_controllability": 9, "chapters/01_model": 3}
 
 
 def _config(root: Path) -> dict:
