@@ -32,14 +32,14 @@ def _children_cpu() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def _stage(cmd: list[str], cwd: Path) -> tuple[float, float]:
-    """Run ``cmd``; its wall and CPU time (s). Stops the benchmark if it fails."""
+def _stage(cmd: list[str], cwd: Path) -> tuple[float, float, str]:
+    """Run ``cmd``; its wall and CPU time (s) and its output. Stops the benchmark if it fails."""
     w, c = time.perf_counter(), _children_cpu()
     proc = subprocess.run(cmd, cwd=cwd, env=dict(os.environ, PYTHONWARNINGS="default"),
                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     if proc.returncode:
         sys.exit(f"{' '.join(cmd)} failed:\n{proc.stdout[-4000:]}")
-    return time.perf_counter() - w, _children_cpu() - c
+    return time.perf_counter() - w, _children_cpu() - c, proc.stdout
 
 
 def main() -> int:
@@ -50,6 +50,9 @@ def main() -> int:
         ex = _stage([sys.executable, str(ROOT / "tools" / "preexecute.py"), "--root", str(book)], book)
         bd = _stage([str(bin_ / "jupyter-book"), "build", "--all", "-W", "-n", "--keep-going", "."], book)
     wall, cpu = ex[0] + bd[0], ex[1] + bd[1]
+    for line in ex[2].splitlines():                   # each page's time, as preexecute printed it
+        if line.startswith("  "):
+            print(f"book: {line.strip()}")
     print(f"book: the pages executed two at a time {ex[0]:.1f} s ({ex[1]:.1f} s of CPU), "
           f"the build from their outputs {bd[0]:.1f} s ({bd[1]:.1f} s of CPU)")
     print(f"book: {wall:.1f} s in all, {cpu:.1f} s of CPU (target <= {TARGET:.0f} s on an idle 2-core "
