@@ -121,3 +121,18 @@ def test_a_build_is_reused_only_when_current(tmp_path, monkeypatch):
     at("_build/html/searchindex.js", 250)
     files["_build/build.rc"].unlink()          # the build did not finish
     assert conftest._current_build() is None
+
+
+def test_pages_are_executed_longest_first_and_the_readers_of_other_pages_last():
+    """``tools/preexecute.py`` executes every notebook page of ``_toc.yml`` (chapters, report,
+    errata), the report and the errata after the chapters whose cached results they read."""
+    import sys
+
+    sys.path.insert(0, str(ROOT / "tools"))
+    from preexecute import LAST, notebook_pages, order
+
+    pages = notebook_pages(ROOT)
+    md = {p.relative_to(ROOT).with_suffix("").as_posix() for p in NOTEBOOKS}
+    assert set(pages) == md - {"intro"}                 # the introduction executes nothing
+    ran = order(pages)
+    assert sorted(ran) == sorted(pages) and ran[-len(LAST):] == list(LAST)

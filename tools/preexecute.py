@@ -51,8 +51,18 @@ def notebook_pages(root: Path = ROOT) -> list[str]:
     """The pages of ``_toc.yml`` that are MyST notebooks (a jupytext header), without suffix."""
     from myst_nb.core.read import is_myst_markdown_notebook
 
-    toc = yaml.safe_load((root / "_toc.yml").read_text())
-    pages = [toc["root"]] + [c["file"] for part in toc.get("parts", []) for c in part.get("chapters", [])]
+    def files(node):                                  # root, parts, chapters, sections, in order
+        if isinstance(node, dict):
+            for k, v in node.items():
+                if k in ("root", "file") and isinstance(v, str):
+                    yield v.removesuffix(".md")
+                else:
+                    yield from files(v)
+        elif isinstance(node, list):
+            for v in node:
+                yield from files(v)
+
+    pages = list(dict.fromkeys(files(yaml.safe_load((root / "_toc.yml").read_text()))))
     return [p for p in pages if (root / f"{p}.md").is_file()
             and is_myst_markdown_notebook((root / f"{p}.md").read_text())]
 
