@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: book test test-portable benchmark clean mutation
+.PHONY: book test test-portable benchmark book-times clean mutation
 
 $(STAMP): requirements.txt pyproject.toml
 	@echo "Installing .venv from requirements.txt and pyproject.toml (a few minutes the first time)..."
@@ -13,12 +13,15 @@ $(STAMP): requirements.txt pyproject.toml
 	$(BIN)/python -m pip install --quiet -r requirements.txt
 	touch $(STAMP)
 
+# The pages are executed two at a time into the execution cache (tools/preexecute.py, which
+# empties it first), then the build reads their outputs from it (_config.yml: execute).
 # The build's output goes to the terminal and to _build/build.log (its time set back to when
 # the build began), its exit status to _build/build.rc: `make test` reuses a build that is
 # current and reads its warnings from that log (tests/conftest.py, fixture built_book).
 book: $(STAMP)
 	mkdir -p _build && rm -f _build/build.rc && touch _build/build.start
-	{ PYTHONWARNINGS=default $(BIN)/jupyter-book build --all -W -n --keep-going . 2>&1; \
+	{ PYTHONWARNINGS=default $(BIN)/python tools/preexecute.py 2>&1 && \
+	  PYTHONWARNINGS=default $(BIN)/jupyter-book build --all -W -n --keep-going . 2>&1; \
 	  echo $$? > _build/build.rc; } | tee _build/build.log
 	touch -r _build/build.start _build/build.log
 	@test "$$(cat _build/build.rc)" = 0 || { echo "Book build failed (see _build/build.log)"; exit 1; }
@@ -61,6 +64,13 @@ benchmark: $(STAMP)
 	$(BIN)/python benchmarks/bench_switched.py
 	$(BIN)/python benchmarks/bench_eight_sweep.py
 	$(BIN)/python benchmarks/bench_scale.py
+	$(BIN)/python benchmarks/bench_book.py
+
+# Where the book's build time goes: each page's and each heavy cell's wall and CPU time, the pages
+# executed one after another in a fresh copy of the book (benchmarks/book_times.py).
+# PAGES="chapters/04_limits report" for some; MIN=0.5 lists the cells above 0.5 s.
+book-times: $(STAMP)
+	$(BIN)/python benchmarks/book_times.py --min $(or $(MIN),1) $(PAGES)
 
 clean:
 	rm -rf _build

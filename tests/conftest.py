@@ -22,7 +22,7 @@ ROOT = Path(__file__).resolve().parents[1]
 # What the book is built from: a build of _build/ older than any of these is stale.
 # (README.md is not part of the book: _config.yml excludes it.)
 BOOK_INPUTS = ("chapters/*.md", "*.md", "reference/*.md", "_config.yml", "_toc.yml", "references.bib",
-               "lib/**/*.py", "_static/*", "_ext/*.py", "requirements.txt")
+               "lib/**/*.py", "_static/*", "_ext/*.py", "tools/*.py", "requirements.txt")
 BUILD_CMD = ["build", "--all", "-W", "-n", "--keep-going", "."]
 
 
@@ -55,7 +55,8 @@ def _current_build() -> subprocess.CompletedProcess | None:
 
 @pytest.fixture(scope="session")
 def built_book() -> subprocess.CompletedProcess:
-    """The book built by ``jupyter-book build --all -W -n --keep-going .``: the one
+    """The book built as ``make book`` builds it (``tools/preexecute.py``, then
+    ``jupyter-book build --all -W -n --keep-going .``): the one
     ``make book`` left in ``_build`` when it is current (see ``_current_build``),
     otherwise built now, leaving the same ``build.log`` and ``build.rc``.
     ``BOOK_REBUILD=1`` forces a build. Under pytest-xdist the workers take a lock on
@@ -79,8 +80,13 @@ def _build_or_reuse(build: Path, force: bool) -> subprocess.CompletedProcess:
     env = dict(os.environ, PYTHONWARNINGS="default")
     (build / "build.rc").unlink(missing_ok=True)
     began = time.time()
-    proc = subprocess.run([str(exe), *BUILD_CMD], cwd=ROOT, env=env,
-                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    # as `make book`: the pages executed two at a time into the execution cache, then the build
+    pre = subprocess.run([sys.executable, str(ROOT / "tools" / "preexecute.py")], cwd=ROOT, env=env,
+                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    proc = pre if pre.returncode else subprocess.run([str(exe), *BUILD_CMD], cwd=ROOT, env=env,
+                                                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    proc = subprocess.CompletedProcess(proc.args, proc.returncode,
+                                       stdout=pre.stdout + (proc.stdout if proc is not pre else ""))
     (build / "build.rc").write_text(f"{proc.returncode}\n")
     (build / "build.log").write_text(proc.stdout)
     os.utime(build / "build.log", (began, began))

@@ -25,6 +25,24 @@ def test_book_builds_with_no_warnings(built_book):
     assert not warnings, "build printed warnings:\n" + "\n".join(warnings[:40])
 
 
+@pytest.mark.book
+def test_every_page_was_executed_two_at_a_time_before_the_build(built_book):
+    """``tools/preexecute.py`` executed every notebook page into the execution cache, and the
+    build found each there: a page whose cache key the build did not match (another reader or
+    MyST configuration) would be executed again by the build, one page after another."""
+    import sys
+
+    sys.path.insert(0, str(ROOT / "tools"))
+    from preexecute import notebook_pages
+
+    log = built_book.stdout + built_book.stderr
+    pages = notebook_pages(ROOT)
+    assert len(pages) >= 8
+    missed = [p for p in pages if not re.search(rf"{re.escape(p)}\.md: Using cached notebook", log)]
+    assert not missed, f"pages executed by the build itself, not read from the cache: {missed}"
+    assert not re.search(r"Executing notebook", log)
+
+
 def code_cells(path: Path):
     """(first line number, metadata, code lines) of each ``{code-cell}`` of a MyST notebook."""
     lines = path.read_text().splitlines()
@@ -103,3 +121,19 @@ def test_a_build_is_reused_only_when_current(tmp_path, monkeypatch):
     at("_build/html/searchindex.js", 250)
     files["_build/build.rc"].unlink()          # the build did not finish
     assert conftest._current_build() is None
+
+
+def test_pages_are_executed_longest_first_and_the_readers_of_other_pages_last():
+    """``tools/preexecute.py`` executes every notebook page of ``_toc.yml`` (the front page,
+    Methods, chapters, report, errata), the report, the errata and the front page after the
+    chapters whose cached results they read."""
+    import sys
+
+    sys.path.insert(0, str(ROOT / "tools"))
+    from preexecute import LAST, notebook_pages, order
+
+    pages = notebook_pages(ROOT)
+    md = {p.relative_to(ROOT).with_suffix("").as_posix() for p in NOTEBOOKS}
+    assert set(pages) == md
+    ran = order(pages)
+    assert sorted(ran) == sorted(pages) and ran[-len(LAST):] == list(LAST)

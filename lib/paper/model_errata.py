@@ -13,6 +13,7 @@ from ..controllability import (free_lie_rank, paper_bracket_count, rest_report, 
 from ..symbolic import (Bracket, _slug, _symbols_only, accessibility_matrix, bracket_latex,
                         compare_printed_brackets, derive_body_frame, evaluate_bracket, lie_bracket,
                         model_fields, printed_brackets, printed_drift, rank_determinants)
+from ..machinery.cache import cached
 from ..params import Body
 from .verdicts import Erratum, Verdict
 
@@ -293,7 +294,7 @@ def _check_rank_condition(printed=None, corrected=None):
     _, _, _, _, v2, w = model.q
     claim = p["a"] * p["m"] * v2 - p["I"] * w
     if printed is None or corrected is None:
-        dets = rank_determinants(model)
+        dets = cached(rank_determinants)        # of that model; shared with Chapter 2 and the report
         printed = dets["printed"] if printed is None else printed
         corrected = dets["derived"] if corrected is None else corrected
 

@@ -56,6 +56,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..machinery import checks
+from ..integrators.compiled import overdamped_period
 from ..params import Body
 from .field import coefficients, rotation_rates, rotation_rates_dphi
 from ..trajectories import PAPER_HEADING_SERIES, eight_position
@@ -243,7 +244,11 @@ def _rate(phi, j, A, B, C, f, corrected: bool):
 
 
 def _period(phi, A, B, C, f, n: int, corrected: bool, record: bool = False):
-    """phi after one period (RK4, n steps); with ``record`` also phi at every step."""
+    """phi after one period (RK4, n steps); with ``record`` also phi at every step. Without
+    ``record`` on the compiled engine (:func:`lib.integrators.compiled.overdamped_period`, the
+    same steps point by point), with it vectorised here."""
+    if not record:
+        return overdamped_period(phi, A, B, C, f, n, corrected)
     h = 2 * np.pi / n
     out = [phi] if record else None
     for i in range(n):
@@ -266,7 +271,8 @@ def _periodic_range(A, B, C, f, H, n: int, corrected: bool, n_starts: int = 16, 
     The map's lift F is increasing with F(x + 2 pi) = F(x) + 2 pi, so g = F - id is
     2 pi-periodic; an attracting fixed point is where g falls through zero. g is
     sampled at ``n_starts`` starts round the reference's heading H(0), the falling
-    crossing nearest p = 0 bracketed and refined by the Illinois method to |g| <= tol.
+    crossing nearest p = 0 bracketed and refined by the Illinois method to |g| <= tol, each
+    point on its own (a located point is not integrated again).
     The extremes of p over the orbit's steps are refined by parabolas (the range is then
     good to about 2e-6 rad: unchanged to that with four times the steps)."""
     N = A.size
@@ -282,18 +288,22 @@ def _periodic_range(A, B, C, f, H, n: int, corrected: bool, n_starts: int = 16, 
     ok = ~slips
     glo, ghi = np.where(ok, glo, 1.0), np.where(ok, ghi, -1.0)
     side = np.zeros(N, dtype=int)
+    xm, gm = np.zeros(N), np.where(ok, np.inf, 0.0)
     for _ in range(100):
-        xm = (lo * ghi - hi * glo) / (ghi - glo)
-        gm = np.where(ok, _period(xm, A, B, C, f, n, corrected) - xm, 0.0)
+        # a point stops once located: only the others are integrated again
+        act = np.abs(gm) > tol
+        xm = np.where(act, (lo * ghi - hi * glo) / (ghi - glo), xm)
+        gm[act] = _period(xm[act], A[act], B[act], C[act], f, n, corrected) - xm[act]
         if np.all(np.abs(gm) <= tol):
             break
         left = gm > 0                            # the fixed point lies above xm
-        lo, glo = np.where(left, xm, lo), np.where(left, gm, glo)
-        hi, ghi = np.where(left, hi, xm), np.where(left, ghi, gm)
+        up, down = act & left, act & ~left
+        lo, glo = np.where(up, xm, lo), np.where(up, gm, glo)
+        hi, ghi = np.where(down, xm, hi), np.where(down, gm, ghi)
         # Illinois: halve the stale end's value when the same end moves twice
-        glo = np.where(~left & (side == -1), 0.5 * glo, glo)
-        ghi = np.where(left & (side == 1), 0.5 * ghi, ghi)
-        side = np.where(left, 1, -1)
+        glo = np.where(down & (side == -1), 0.5 * glo, glo)
+        ghi = np.where(up & (side == 1), 0.5 * ghi, ghi)
+        side = np.where(up, 1, np.where(down, -1, side))
     else:
         raise RuntimeError("the periodic heading was not located to tolerance in 100 iterations")
     _, rec = _period(xm, A, B, C, f, n, corrected, record=True)

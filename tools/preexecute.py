@@ -1,0 +1,147 @@
+"""Execute the book's notebook pages two at a time, into the execution cache the build reads.
+
+Jupyter Book 1 executes the pages one after another. ``make book`` runs this script first:
+it empties the execution cache (``execute.cache`` of ``_config.yml``, ``_build/.jupyter_cache``),
+executes every notebook page of ``_toc.yml`` afresh in ``--jobs`` processes (default 2), each
+page in its own kernel in its own folder as the build would, and stores each executed notebook in
+that cache (jupyter-cache, the store myst-nb reads with ``execute_notebooks: cache``). The build
+that follows then finds every page's outputs there instead of executing it. Each page is read with
+myst-nb's own reader and the build's MyST configuration, so its cache key (the code cells and
+their metadata) is the one the build looks up; a page it misses is executed by the build itself.
+
+The kernels run with BLAS single-threaded (:data:`KERNEL_ENV`). Nothing from an earlier build is
+reused: the cache is emptied first, and a page that fails stops
+the script with its traceback (the build is then not run). Pages that read other pages' results
+(``LAST``: the report, the errata and the front page's findings read the chapters' through :mod:`lib.machinery.cache`) start
+last; the others start longest first (``COST``, measured by ``benchmarks/book_times.py``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import resource
+import shutil
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from multiprocessing import get_context
+from pathlib import Path
+
+import yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+#: pages that read what other pages cached: started after the others
+LAST = ("errata", "report", "intro")
+#: the kernels' environment: BLAS single-threaded. The book's matrices are small (2 x 2 to
+#: 6 x 6, stacks of them), so OpenBLAS's threads only spin: measured, Chapter 3's check of (24)
+#: (scipy's expm on a stack of 2 x 2 matrices) took 0.72 s of CPU with them and 0.08 s without,
+#: on a loaded machine. numba keeps its threads (its kernels are the pages' heavy work).
+KERNEL_ENV = {"OPENBLAS_NUM_THREADS": "1"}
+#: a page's CPU time (s), measured, to start the longest first (unknown pages first of all)
+COST = {"chapters/04_limits": 166, "chapters/05_stability": 100, "chapters/03_tracking": 52,
+        "chapters/06_allocation": 33, "chapters/07_percussion": 10, "chapters/02_controllability": 9,
+        "chapters/01_model": 3, "methods": 1}
+
+
+def _config(root: Path) -> dict:
+    return yaml.safe_load((root / "_config.yml").read_text())
+
+
+def notebook_pages(root: Path = ROOT) -> list[str]:
+    """The pages of ``_toc.yml`` that are MyST notebooks (a jupytext header), without suffix."""
+    from myst_nb.core.read import is_myst_markdown_notebook
+
+    def files(node):                                  # root, parts, chapters, sections, in order
+        if isinstance(node, dict):
+            for k, v in node.items():
+                if k in ("root", "file") and isinstance(v, str):
+                    yield v.removesuffix(".md")
+                else:
+                    yield from files(v)
+        elif isinstance(node, list):
+            for v in node:
+                yield from files(v)
+
+    pages = list(dict.fromkeys(files(yaml.safe_load((root / "_toc.yml").read_text()))))
+    return [p for p in pages if (root / f"{p}.md").is_file()
+            and is_myst_markdown_notebook((root / f"{p}.md").read_text())]
+
+
+def read_page(md: Path, root: Path = ROOT):
+    """The page as the build reads it: myst-nb's reader with the book's MyST extensions."""
+    from myst_nb.core.read import read_myst_markdown_notebook
+    from myst_parser.config.main import MdParserConfig
+
+    ext = _config(root).get("parse", {}).get("myst_enable_extensions", [])
+    return read_myst_markdown_notebook(md.read_text(), config=MdParserConfig(enable_extensions=set(ext)),
+                                       add_source_map=True, path=str(md))
+
+
+def _execute(md: str, root: str, timeout: int, allow_errors: bool):
+    """Execute one page in its folder (in a worker process); the notebook, the error's text,
+    the wall time and the kernel's CPU time (s)."""
+    from jupyter_cache.executors.utils import single_nb_execution
+
+    nb = read_page(Path(md), Path(root))
+    cpu = _children_cpu()
+    res = single_nb_execution(nb, cwd=str(Path(md).parent), timeout=timeout, allow_errors=allow_errors,
+                              meta_override=True)
+    # the kernel, a child of this worker, has ended and been waited for: its CPU time
+    return nb, (res.exc_string if res.err is not None else None), res.time, _children_cpu() - cpu
+
+
+def _children_cpu() -> float:
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def order(pages: list[str]) -> list[str]:
+    """Longest first (by :data:`COST`), the pages of :data:`LAST` at the end."""
+    first = [p for p in pages if p not in LAST]
+    return (sorted(first, key=lambda p: -COST.get(p, float("inf")))
+            + [p for p in LAST if p in pages])
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--jobs", type=int, default=int(os.environ.get("BOOK_JOBS", "2")),
+                    help="pages executed at once (default 2, or $BOOK_JOBS)")
+    ap.add_argument("--root", type=Path, default=ROOT, help="the book's folder")
+    ap.add_argument("pages", nargs="*", help="only these pages (default: every notebook page of _toc.yml)")
+    args = ap.parse_args(argv)
+    from jupyter_cache import get_cache
+    from jupyter_cache.base import CacheBundleIn
+
+    root = args.root.resolve()
+    os.environ.update(KERNEL_ENV)                         # inherited by the workers' kernels
+    execute = _config(root).get("execute", {})
+    path = root / execute.get("cache", "_build/.jupyter_cache")
+    shutil.rmtree(path, ignore_errors=True)               # nothing from an earlier build
+    cache = get_cache(path)
+    pages = order([p for p in notebook_pages(root) if not args.pages or p in args.pages])
+    timeout, allow = int(execute.get("timeout", 30)), bool(execute.get("allow_errors", False))
+    print(f"Executing {len(pages)} pages, {args.jobs} at a time, into {path.relative_to(root)}", flush=True)
+    tic, failed = time.perf_counter(), []
+    # spawned workers: a fork after numba's threads have run aborts (lib.machinery.parallel)
+    with ProcessPoolExecutor(args.jobs, mp_context=get_context("spawn")) as pool:
+        jobs = {pool.submit(_execute, str(root / f"{p}.md"), str(root), timeout, allow): p for p in pages}
+        for fut in as_completed(jobs):
+            page = jobs[fut]
+            nb, err, seconds, cpu = fut.result()
+            if err is not None:
+                failed.append(page)
+                print(f"  {page}: FAILED after {seconds:.1f} s\n{err}", flush=True)
+                continue
+            md = root / f"{page}.md"
+            record = cache.add_nb_to_project(str(md), read_data={"type": "plugin", "name": "myst_nb_md"})
+            cache.cache_notebook_bundle(CacheBundleIn(nb, record.uri, data={"execution_seconds": seconds}),
+                                        check_validity=False, overwrite=True)
+            print(f"  {page}: {seconds:.1f} s ({cpu:.1f} s of CPU)", flush=True)
+    print(f"Executed in {time.perf_counter() - tic:.1f} s" + (f"; failed: {', '.join(failed)}" if failed else ""),
+          flush=True)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
