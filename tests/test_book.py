@@ -67,7 +67,8 @@ def code_cells(path: Path):
         i = j + 1
 
 
-NOTEBOOKS = sorted(ROOT.glob("chapters/*.md")) + [ROOT / "report.md", ROOT / "errata.md", ROOT / "intro.md"]
+NOTEBOOKS = sorted(ROOT.glob("chapters/*.md")) + [ROOT / "report.md", ROOT / "errata.md", ROOT / "intro.md",
+                                                 ROOT / "methods.md"]
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.relative_to(ROOT).as_posix())

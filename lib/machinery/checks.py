@@ -1,6 +1,6 @@
 """The one set of argument validators of the public API.
 
-Every public entry point of :mod:`lib` checks its arguments with these few
+Every public entry point of ``lib`` checks its arguments with these few
 functions, so a wrong argument fails the same way everywhere:
 
 * a wrong *type* (a str, a bool, None, a list where a number belongs) raises

@@ -42,8 +42,8 @@ LOST_FACTOR = 4
 
 def fig5_map(body: Body, n: int = FIG5_GRID["n"], *, confirm=("perturbed",), lost_factor: int | None = LOST_FACTOR,
              executor=None, chunk_size: int | None = None, progress: bool | None = None) -> pd.DataFrame:
-    """The book's Fig. 5 (Chapter 5, and the report's row on it): :func:`eight_rotation_sweep`
-    on the n x n grid :data:`FIG5_GRID`, Theta varying slowest; then the headings lost
+    """The book's Fig. 5 (Chapter 5, and the report's row on it): :func:`lib.rotation.verdicts.eight_rotation_sweep`
+    on the n x n grid :data:`lib.rotation.verdicts.FIG5_GRID`, Theta varying slowest; then the headings lost
     without an orbit tested over ``lost_factor`` times their horizon (:func:`confirm_lost`;
     None skips), and the points that saw a chaotic transient decided again by ``confirm``
     (:func:`confirm_attractors`; ``()`` skips).
