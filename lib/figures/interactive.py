@@ -142,7 +142,7 @@ def fig5_figure(frame: pd.DataFrame, *, height: int = 620) -> go.Figure:
     Parameters
     ----------
     frame : pandas.DataFrame
-        Verdicts of :func:`lib.rotation.verdicts.fig5_map` (columns R, Theta, regime, period,
+        Verdicts of :func:`lib.rotation.fig5.fig5_map` (columns R, Theta, regime, period,
         floquet, lyapunov, lyapunov_stderr, range, lost).
     height : int
         The figure's height (px).
