@@ -482,7 +482,7 @@ def test_hovering_a_known_point_shows_its_verdict(point, hovered):
     assert shown and shown[0].split(",")[0] == verdict, f"#{fig} at ({x}, {y}): tooltip {lines}"
     label = "R: " if fig == "interactive-fig5" else "angle limit: "
     value = [ln for ln in lines if ln.startswith(label)]
-    assert value and abs(float(value[0][len(label):].split()[0]) - x) < 1e-3, (
+    assert value and abs(float(value[0][len(label):].split()[0]) - x) < 1e-3, (  # reason: the tooltip's printed digits
         f"#{fig}: hovered ({x}, {y}) but the tooltip is of another point: {lines}")
     for name in ("period", "largest |μ|", "exponent", "range of p"):
         assert any(ln.startswith(name) for ln in lines), f"#{fig}: no {name!r} in the tooltip {lines}"

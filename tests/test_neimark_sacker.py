@@ -30,7 +30,7 @@ def test_orbit_loses_stability_at_the_located_cap_to_the_root_finders_xtol(birth
     assert birth.modulus_above > 1.0 + MU_ERROR
     caps = birth.path.force_limit.to_numpy()
     assert min(caps[-2:]) <= birth.force_limit <= max(caps[-2:])
-    assert (birth.path.residual <= 1e-9).all()
+    assert (birth.path.residual <= 1e-9).all()  # accuracy: Newton's tolerance on the orbit
 
 
 def test_crossing_multipliers_are_a_complex_pair_on_the_unit_circle(birth):
@@ -38,14 +38,14 @@ def test_crossing_multipliers_are_a_complex_pair_on_the_unit_circle(birth):
     assert mu.imag > 0.1                       # a complex pair, not a real multiplier: not a fold or a flip
     assert abs(abs(mu) - 1.0) <= max(1.0 - birth.modulus_below, birth.modulus_above - 1.0)
     assert 0.0 < birth.rotation < 0.5
-    assert birth.rotation == pytest.approx(np.angle(mu) / (2 * np.pi), abs=1e-15)
+    assert birth.rotation == pytest.approx(np.angle(mu) / (2 * np.pi), abs=1e-15)  # exact: the same formula
 
 
 def test_crossing_is_the_same_with_twice_the_steps_a_period(birth):
     body, gains, ref, b = Body(), Gains(), eight(), math.radians(torus.NS_ANGLE_DEG)
     fine = [torus.cap_orbit(body, gains, ref, b, birth.force_limit + s * birth.xtol, birth.orbit,
                             steps_per_period=2 * torus.STEPS_PER_PERIOD) for s in (-1, 1)]
-    assert fine[0].residual <= 1e-9 and fine[1].residual <= 1e-9
+    assert fine[0].residual <= 1e-9 and fine[1].residual <= 1e-9  # accuracy: Newton's tolerance
     assert fine[0].modulus < 1.0 < fine[1].modulus
 
 
@@ -59,5 +59,5 @@ def test_rotation_on_the_invariant_circle_tends_to_arg_mu_over_2_pi(birth):
 
 def test_invariant_circle_grows_as_the_square_root_of_the_distance(birth):
     # supercritical: amplitude ~ (F - F_c)^(1/2), to first order in the distances (0.01, 0.03 N)
-    assert birth.amplitude_exponent == pytest.approx(0.5, abs=0.1)
+    assert birth.amplitude_exponent == pytest.approx(0.5, abs=0.1)  # reason: first order in distances 0.01, 0.03 N
     assert all(c.amplitude < 0.5 for c in birth.circles)     # small, born at the orbit
