@@ -56,7 +56,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..machinery import checks
-from ..integrators.compiled import overdamped_period
 from ..params import Body
 from .field import coefficients, rotation_rates, rotation_rates_dphi
 from ..trajectories import PAPER_HEADING_SERIES, eight_position
@@ -248,6 +247,9 @@ def _period(phi, A, B, C, f, n: int, corrected: bool, record: bool = False):
     ``record`` on the compiled engine (:func:`lib.integrators.compiled.overdamped_period`, the
     same steps point by point), with it vectorised here."""
     if not record:
+        # imported here: numba's import and compile, and the compiled engine imports
+        # lib.rotation.field, whose package imports this module
+        from ..integrators.compiled import overdamped_period
         return overdamped_period(phi, A, B, C, f, n, corrected)
     h = 2 * np.pi / n
     out = [phi] if record else None
