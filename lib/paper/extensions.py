@@ -21,7 +21,8 @@ from ..limits.attractors import (heading_offset_starts, lyapunov_horizons, mirro
                                  start_attractors)
 from ..tracking.mismatch import mismatch_study
 from ..dynamics.verdicts import held
-from ..percussion import circle_lock_radius, circle_steady_motion, percussion_fig5_map
+from ..percussion import (centre_of_percussion, circle_lock_radius, circle_steady_motion,
+                          percussion_fig5_map)
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from ..rotation.fig5 import fig5_map
 from ..rotation.slow_eight import slow_eight_prediction
@@ -140,7 +141,7 @@ def _check_lyapunov() -> Outcome:
 def _check_percussion_circle() -> Outcome:
     body = Body()
     p0 = circle_equilibria(body, R0, THETA0)[0]
-    s = -body.I / (body.m * body.a)
+    s = centre_of_percussion(body)
     R_P = math.sqrt(R0**2 - 2 * R0 * s * math.sin(p0) + s**2)
     st = circle_steady_motion(body, R_P, THETA0)
     gap = abs(st.radius_C / R0 - 1.0)
