@@ -29,10 +29,11 @@ from pathlib import Path
 
 import jupytext
 import nbformat
-import yaml
 from nbclient import NotebookClient
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tools"))
+from preexecute import notebook_pages, toc_pages  # noqa: E402  (the build's one reading of _toc.yml)
 #: what a page's execution may read besides its own source
 BOOK_FILES = ("_config.yml", "_toc.yml", "references.bib")
 BOOK_DIRS = ("_static", "_ext")
@@ -62,21 +63,6 @@ print(_bt_json.dumps({"cells": _bt_cells,
 """
 
 
-def toc_pages(root: Path = ROOT) -> list[str]:
-    """The pages of ``_toc.yml`` in their order (root first), as paths without suffix."""
-    toc = yaml.safe_load((root / "_toc.yml").read_text())
-    pages = [toc["root"]]
-    for part in toc.get("parts", []):
-        pages += [c["file"] for c in part.get("chapters", [])]
-    return pages
-
-
-def is_notebook(md: Path) -> bool:
-    """A MyST page with a jupytext header (a kernelspec): executed by the build."""
-    head = md.read_text().split("\n---", 1)[0]
-    return md.read_text().startswith("---") and "kernelspec" in head
-
-
 def copy_book(dest: Path, root: Path = ROOT) -> None:
     """The book's sources (pages, configuration, static files) into ``dest``."""
     for f in BOOK_FILES:
@@ -84,9 +70,9 @@ def copy_book(dest: Path, root: Path = ROOT) -> None:
     for d in BOOK_DIRS:
         if (root / d).is_dir():
             shutil.copytree(root / d, dest / d)
-    for md in [*root.glob("*.md"), *root.glob("chapters/*.md")]:
-        (dest / md.relative_to(root)).parent.mkdir(parents=True, exist_ok=True)
-        shutil.copy2(md, dest / md.relative_to(root))
+    for page in toc_pages(root):                      # every page the table of contents names
+        (dest / page).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(root / f"{page}.md", dest / f"{page}.md")
 
 
 def run_page(md: Path, timeout: int = 900) -> dict:
@@ -122,7 +108,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--min", type=float, default=1.0, help="list cells above this CPU or wall time (s)")
     ap.add_argument("--json", type=Path, help="write every cell's times to this file")
     args = ap.parse_args(argv)
-    pages = [p.removesuffix(".md") for p in args.pages] or toc_pages()
+    notebooks = notebook_pages()
+    pages = ([p.removesuffix(".md") for p in args.pages if p.removesuffix(".md") in notebooks]
+             if args.pages else notebooks)
     results = []
     with tempfile.TemporaryDirectory(prefix="book-times-") as tmp:
         book = Path(tmp)
@@ -131,10 +119,7 @@ def main(argv: list[str] | None = None) -> int:
         # errata and the report, which read what the chapters cached
         order = sorted(pages)
         for page in order:
-            md = book / f"{page}.md"
-            if not is_notebook(md):
-                continue
-            res = run_page(md)
+            res = run_page(book / f"{page}.md")
             res["page"] = page
             results.append(res)
             print(f"{page:<28} wall {res['wall']:6.1f} s   CPU {res['cpu']:6.1f} s", flush=True)

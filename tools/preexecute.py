@@ -48,9 +48,8 @@ def _config(root: Path) -> dict:
     return yaml.safe_load((root / "_config.yml").read_text())
 
 
-def notebook_pages(root: Path = ROOT) -> list[str]:
-    """The pages of ``_toc.yml`` that are MyST notebooks (a jupytext header), without suffix."""
-    from myst_nb.core.read import is_myst_markdown_notebook
+def toc_pages(root: Path = ROOT) -> list[str]:
+    """Every page of ``_toc.yml`` (root, parts, chapters, sections), in order, without suffix."""
 
     def files(node):                                  # root, parts, chapters, sections, in order
         if isinstance(node, dict):
@@ -63,8 +62,14 @@ def notebook_pages(root: Path = ROOT) -> list[str]:
             for v in node:
                 yield from files(v)
 
-    pages = list(dict.fromkeys(files(yaml.safe_load((root / "_toc.yml").read_text()))))
-    return [p for p in pages if (root / f"{p}.md").is_file()
+    return list(dict.fromkeys(files(yaml.safe_load((root / "_toc.yml").read_text()))))
+
+
+def notebook_pages(root: Path = ROOT) -> list[str]:
+    """The pages of ``_toc.yml`` that are MyST notebooks (a jupytext header), without suffix."""
+    from myst_nb.core.read import is_myst_markdown_notebook
+
+    return [p for p in toc_pages(root) if (root / f"{p}.md").is_file()
             and is_myst_markdown_notebook((root / f"{p}.md").read_text())]
 
 
