@@ -28,3 +28,16 @@ its arguments with ``lib.machinery.checks``: a wrong type is a ``TypeError``, a 
 README.md's "Where to start in the library" runs a small Fig. 5 map and a capped circle;
 the book's "Library reference" page (``reference.md``) is generated from the docstrings.
 """
+
+import os as _os
+
+# numba's parallel kernels run on its OpenMP threading layer, whose threads by default spin
+# while they wait at the end of a parallel loop. The verdicts call the kernels thousands of
+# times on a few rows each (Newton's iterations), so the spinning thread takes a core from
+# whatever else runs: on the 2-core machine, beside one other busy process, Fig. 5's sweep
+# took 74 s of CPU with spinning threads and 31 s with sleeping ones (the same 31 s as on
+# one thread). Waiting threads sleep unless the user chose otherwise; the results do not
+# depend on it (each point of a parallel loop is computed alone).
+_os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+del _os
+

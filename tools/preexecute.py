@@ -36,11 +36,13 @@ LAST = ("errata", "report", "intro")
 #: the kernels' environment: BLAS single-threaded. The book's matrices are small (2 x 2 to
 #: 6 x 6, stacks of them), so OpenBLAS's threads only spin: measured, Chapter 3's check of (24)
 #: (scipy's expm on a stack of 2 x 2 matrices) took 0.72 s of CPU with them and 0.08 s without,
-#: on a loaded machine. numba keeps its threads (its kernels are the pages' heavy work).
+#: on a loaded machine. numba keeps its threads (its kernels are the pages' heavy work); they
+#: sleep while they wait (OMP_WAIT_POLICY=PASSIVE, set by lib/__init__.py), so that two pages'
+#: kernels do not spin against each other (measured: Chapter 5 took 96 s of CPU instead of 176).
 KERNEL_ENV = {"OPENBLAS_NUM_THREADS": "1"}
 #: a page's CPU time (s), measured, to start the longest first (unknown pages first of all)
-COST = {"chapters/04_limits": 166, "chapters/05_stability": 100, "chapters/03_tracking": 52,
-        "chapters/06_allocation": 33, "chapters/07_percussion": 10, "chapters/02_controllability": 9,
+COST = {"chapters/04_limits": 167, "chapters/05_stability": 96, "chapters/03_tracking": 41,
+        "chapters/06_allocation": 31, "chapters/07_percussion": 8, "chapters/02_controllability": 10,
         "chapters/01_model": 3, "methods": 1}
 
 
