@@ -282,3 +282,22 @@ def test_a_regime_compares_equal_to_its_copy_section_and_nan_included():
     from lib.limits.sections import Regime
     r = Regime(0.5, np.array([[1.0, np.nan]]), 1, False, np.nan, 0.1, "periodic", 3, 0.2)
     assert r == replace(r) and r != replace(r, section=np.array([[1.0, 2.0]])) and r != replace(r, period=2)
+
+
+def test_check_grid_broadcasts_one_value_and_names_a_bad_entry():
+    """The one check of every (R, Theta) sweep (lib.rotation.reduced.check_grid, used by
+    Chapters 5 and 7): a length-1 array is broadcast, unequal lengths, NaN and non-positive
+    entries are refused, each named."""
+    from lib.rotation.reduced import check_grid
+
+    R, Th = check_grid(2.0, [0.5, 0.7, 0.9])
+    assert R.tolist() == [2.0, 2.0, 2.0] and Th.tolist() == [0.5, 0.7, 0.9]
+    assert R.dtype == float and Th.dtype == float
+    with pytest.raises(ValueError, match="equal lengths"):
+        check_grid([1.0, 2.0], [0.5, 0.7, 0.9])
+    with pytest.raises(ValueError, match=r"Theta\[1\]"):
+        check_grid([1.0, 2.0], [0.5, -0.7])
+    with pytest.raises(ValueError, match=r"R\[0\]"):
+        check_grid([math.nan, 2.0], [0.5, 0.7])
+    with pytest.raises(ValueError, match="1-D"):
+        check_grid(np.ones((2, 2)), np.ones((2, 2)))

@@ -21,7 +21,7 @@ from ..angles import wrap_angle
 from ..dynamics import verdicts as dv
 from ..machinery.parallel import concat_frames, map_chunks
 from ..params import Body
-from ..rotation.reduced import _check_grid
+from ..rotation.reduced import check_grid
 from ..rotation.verdicts import FIG5_GRID
 from ..dynamics.sampled import sampled_range
 from .engine import HeadingEngine, HeadingMap, coefficients
@@ -85,7 +85,7 @@ def rotation_sweep(body: Body, R, Theta, *, kind: str = "eight", p0=0.0, executo
     """
     checks.instance("body", body, Body)
     checks.one_of("kind", kind, ("eight", "circle"))
-    R, Theta = _check_grid(R, Theta)
+    R, Theta = check_grid(R, Theta)
     o = _options(options)
     p0 = checks.array("p0", p0)
     try:

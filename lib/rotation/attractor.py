@@ -17,7 +17,7 @@ from ..machinery import checks
 from ..angles import wrap_angle
 from ..dynamics.verdicts import REGIMES, orbit_points
 from ..params import Body
-from .reduced import _check_grid, _shape
+from .reduced import check_grid, _shape
 from .engine import RotationMap, _Engine
 from .field import coefficients
 from .verdicts import SLOW_FLOQUET, _check_body_kind, _step_counts, _verdict_core, _verdict_options
@@ -112,7 +112,7 @@ def rotation_attractor(body: Body, kind: str, R: float, Theta: float, *, p0: flo
     for name, v in (("R", R), ("Theta", Theta), ("p0", p0), ("v0", v0)):
         if isinstance(v, bool) or not np.isscalar(v) or not isinstance(v, (int, float, np.integer, np.floating)):
             raise TypeError(f"{name} must be a real scalar, got {type(v).__name__}")
-    R_, Th = _check_grid([R], [Theta])
+    R_, Th = check_grid([R], [Theta])
     if not (np.isfinite(p0) and np.isfinite(v0)):
         raise ValueError("initial p0 and v0 must be finite")
     _check_body_kind(body, kind)

@@ -31,7 +31,7 @@ from .slow_eight import SlowEight, slow_eight_prediction  # re-exported: Chapter
 from ..trajectories import KINEMATICS, POSITIONS
 
 __all__ = [
-    "steps_per_period", "reduced_rotation", "classify_samples", "sampled_range", "sampled_extremes", "rotation_sweep",
+    "check_grid", "steps_per_period", "reduced_rotation", "classify_samples", "sampled_range", "sampled_extremes", "rotation_sweep",
     "ENGINES", "rotation_period_map", "rotation_orbit", "RotationLyapunov",
     "rotation_lyapunov", "WINDING", "SlowEight", "slow_eight_prediction",
 ]
@@ -60,9 +60,27 @@ def _unit_forcing(kind: str, s):
     return vx, vy, ax, ay
 
 
-def _check_grid(R, Theta):
+def check_grid(R, Theta) -> tuple[np.ndarray, np.ndarray]:
     """The points (R_i (m), Theta_i (rad/s)) of a sweep as two equal 1-D float arrays,
-    by :mod:`lib.machinery.checks` (a NaN or a non-positive entry is named by its index)."""
+    by :mod:`lib.machinery.checks` (a NaN or a non-positive entry is named by its index);
+    a length-1 R or Theta is broadcast to the other's length. Every sweep over the
+    (R, Theta) plane checks its grid with it (Chapters 5 and 7).
+
+    Parameters
+    ----------
+    R, Theta : array_like
+        Radii (m) and rates (rad/s), 1-D, > 0, of equal lengths (or one of length 1).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        R and Theta, 1-D float arrays of one length.
+
+    Raises
+    ------
+    ValueError
+        Naming the array and the index of a NaN or non-positive entry, or the shapes.
+    """
     R = np.atleast_1d(checks.array("R", R))
     Theta = np.atleast_1d(checks.array("Theta", Theta))
     if R.ndim != 1 or Theta.ndim != 1:
@@ -141,7 +159,7 @@ def reduced_rotation(body: Body, kind: str, R: float, Theta: float, periods: int
     p : numpy.ndarray
         The rotation error (rad).
     """
-    R_, Th_ = _check_grid(R, Theta)
+    R_, Th_ = check_grid(R, Theta)
     n = int(steps or steps_per_period(body, kind, R_, Th_)[0])
     at, winding = _shape(kind)
     phi, w = _run(body, kind, R_, Th_, n, periods, np.array([p0]), np.array([v0]), record=True)
@@ -256,7 +274,7 @@ def rotation_sweep(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, tol: floa
     """
     checks.one_of("kind", kind, ("eight", "circle"))
     checks.instance("body", body, Body)
-    R, Theta = _check_grid(R, Theta)
+    R, Theta = check_grid(R, Theta)
     N = R.size
     p0 = np.broadcast_to(checks.array("p0", p0), (N,)).copy()
     v0 = np.broadcast_to(checks.array("v0", v0), (N,)).copy()
@@ -330,7 +348,7 @@ def rotation_period_map(body: Body, kind: str, R, Theta, *, steps: int | None = 
     """
     checks.one_of("kind", kind, ("eight", "circle"))
     checks.instance("body", body, Body)
-    R, Theta = _check_grid(R, Theta)
+    R, Theta = check_grid(R, Theta)
     n = (checks.integer("steps", steps, minimum=1) if steps is not None
          else int(steps_per_period(body, kind, R, Theta, h_lambda).max()))
     A, B, C = coefficients(body, R, Theta)
@@ -391,7 +409,7 @@ def rotation_orbit(body: Body, kind: str, R, Theta, *, k: int = 1, slip: int = 0
     Orbit
         The orbit points x (N, 2), the Jacobian there, residuals, convergence and iterations.
     """
-    R, Theta = _check_grid(R, Theta)
+    R, Theta = check_grid(R, Theta)
     step = rotation_period_map(body, kind, R, Theta, steps=steps)
     phi, w = _initial(kind, Theta, np.broadcast_to(np.asarray(p0, float), R.shape),
                       np.broadcast_to(np.asarray(v0, float), R.shape))
@@ -450,7 +468,7 @@ def rotation_lyapunov(body: Body, kind: str, R, Theta, *, periods: int = 200, tr
     """
     periods = checks.integer("periods", periods, minimum=2)
     transient = checks.integer("transient", transient, minimum=0)
-    R, Theta = _check_grid(R, Theta)
+    R, Theta = check_grid(R, Theta)
     step = rotation_period_map(body, kind, R, Theta, steps=steps)
     phi, w = _initial(kind, Theta, np.broadcast_to(np.asarray(p0, float), R.shape),
                       np.broadcast_to(np.asarray(v0, float), R.shape))

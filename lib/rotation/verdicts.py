@@ -27,7 +27,7 @@ from ..dynamics import verdicts as dv
 from ..dynamics.orbits import floquet_multipliers
 from ..machinery.parallel import concat_frames, map_chunks
 from ..params import Body
-from .reduced import ENGINES, _check_grid, _initial
+from .reduced import ENGINES, check_grid, _initial
 from .engine import RotationMap, _Engine, check_domain, orbit_range, verdict_steps
 from .field import coefficients
 
@@ -212,7 +212,7 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
     """
     _check_body_kind(body, kind)
     checks.one_of("engine", engine, sorted(ENGINES))
-    R, Theta = _check_grid(R, Theta)
+    R, Theta = check_grid(R, Theta)
     h_lambda = checks.number("h_lambda", h_lambda, positive=True)
     check_domain(body, kind, R, Theta, h_lambda)
     opts = _verdict_options(options)
