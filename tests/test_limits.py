@@ -338,7 +338,7 @@ def test_switched_runs_reject_bad_input():
         L.switched_runs(Body(), Gains(), object(), 0.5, n_periods=1)
     with pytest.raises(ValueError, match="n_periods"):
         L.switched_runs(Body(), Gains(), ref, 0.5, n_periods=0)
-    with pytest.raises(TypeError, match="unknown options"):
+    with pytest.raises(TypeError, match="unknown option"):
         L.limit_verdicts(Body(), Gains(), ref, 0.5, transients=3)
     with pytest.raises(RuntimeError, match="non-finite"):
         L.switched_runs(Body(), Gains(), ref, 0.5, s0=[0, 0, 0, 1e308, 0, 0], n_periods=1)

@@ -301,3 +301,24 @@ def test_check_grid_broadcasts_one_value_and_names_a_bad_entry():
         check_grid([math.nan, 2.0], [0.5, 0.7])
     with pytest.raises(ValueError, match="1-D"):
         check_grid(np.ones((2, 2)), np.ones((2, 2)))
+
+
+def test_options_merge_the_defaults_and_check_each_by_its_kind():
+    """checks.options, behind every sweep's **options: integers at their minima, the rest
+    positive numbers, unknown names refused with the known ones listed, extra names passed by."""
+    defaults = dict(periods=120, block=12, newton_tol=1e-9)
+    minima = dict(periods=2, block=2)
+    o = checks.options(dict(block=np.int64(6), newton_tol=1e-8), defaults, minima)
+    assert o == dict(periods=120, block=6, newton_tol=1e-8)
+    assert type(o["block"]) is int and type(o["newton_tol"]) is float
+    assert checks.options(dict(max_periods=9), defaults, minima, extra=("max_periods",)) == defaults
+    with pytest.raises(TypeError, match=r"unknown option\(s\) \['blocks'\]; known: \['block', 'newton_tol'"):
+        checks.options(dict(blocks=6), defaults, minima)
+    with pytest.raises(ValueError, match="block must be an integer >= 2, got 1"):
+        checks.options(dict(block=1), defaults, minima)
+    with pytest.raises(TypeError, match="periods must be an integer"):
+        checks.options(dict(periods=12.0), defaults, minima)
+    with pytest.raises(ValueError, match="newton_tol"):
+        checks.options(dict(newton_tol=0.0), defaults, minima)
+    with pytest.raises(ValueError, match="newton_tol"):
+        checks.options(dict(newton_tol=math.inf), defaults, minima)

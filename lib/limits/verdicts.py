@@ -151,13 +151,7 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
     runs : SwitchedRuns
         The runs behind it, in the order of the pairs.
     """
-    unknown = set(options) - set(LIMIT_DEFAULTS)
-    if unknown:
-        raise TypeError(f"unknown options {sorted(unknown)}; known: {sorted(LIMIT_DEFAULTS)}")
-    o = {**LIMIT_DEFAULTS, **options}
-    for name, v in o.items():
-        minimum = {"transient": 0, "periods": 2, "block": 2, "max_period": 1}.get(name)
-        o[name] = checks.number(name, v, positive=True) if minimum is None else checks.integer(name, v, minimum=minimum)
+    o = checks.options(options, LIMIT_DEFAULTS, dict(transient=0, periods=2, block=2, max_period=1))
     npr, blk, kmax = o["periods"], o["block"], o["max_period"]
     if npr < 2 * blk or npr < 2 * kmax + 2:
         raise ValueError(f"periods ({npr}) must cover two blocks ({blk}) and twice max_period ({kmax})")

@@ -19,11 +19,11 @@ call unvalidated kernels.
 from __future__ import annotations
 
 import numbers
-from typing import Any, Iterable
+from typing import Any, Iterable, Mapping
 
 import numpy as np
 
-__all__ = ["number", "integer", "array", "one_of", "flag", "instance"]
+__all__ = ["number", "integer", "array", "one_of", "flag", "instance", "options"]
 
 
 def _is_real(value: Any) -> bool:
@@ -113,6 +113,45 @@ def integer(name: str, value: Any, *, minimum: int | None = None) -> int:
     if minimum is not None and v < minimum:
         raise ValueError(f"{name} must be an integer >= {minimum}, got {v}")
     return v
+
+
+def options(given: Mapping[str, Any], defaults: Mapping[str, Any], minima: Mapping[str, int],
+            extra: Iterable[str] = ()) -> dict:
+    """A procedure's keyword options merged over its defaults and checked: the names in
+    ``minima`` are integers at least that, every other default a positive number. The sweeps'
+    ``**options`` (Chapters 4 to 7) are checked by it.
+
+    Parameters
+    ----------
+    given : Mapping
+        The options passed (``**options``).
+    defaults : Mapping
+        Every option's default.
+    minima : Mapping
+        The integer options and their least values.
+    extra : Iterable of str
+        Names accepted besides the defaults, left out of the result (the caller reads them
+        from ``given``).
+
+    Returns
+    -------
+    dict
+        The defaults updated with ``given``, each value checked.
+
+    Raises
+    ------
+    TypeError
+        Naming the unknown options and the known ones, or an option of the wrong type.
+    ValueError
+        Naming an option out of its range.
+    """
+    known = set(defaults) | set(extra)
+    unknown = set(given) - known
+    if unknown:
+        raise TypeError(f"unknown option(s) {sorted(unknown)}; known: {sorted(known)}")
+    o = dict(defaults, **{k: v for k, v in given.items() if k in defaults})
+    return {name: integer(name, v, minimum=minima[name]) if name in minima else number(name, v, positive=True)
+            for name, v in o.items()}
 
 
 def _first_bad(mask: np.ndarray) -> str:

@@ -37,17 +37,8 @@ _NEWTON = dict(max_iter=30, max_step=1.0, polish=1e-13)
 
 
 def _options(options: dict) -> dict:
-    unknown = set(options) - set(_DEFAULTS)
-    if unknown:
-        raise TypeError(f"unknown option(s) {sorted(unknown)}; known: {sorted(_DEFAULTS)}")
-    o = dict(_DEFAULTS, **options)
-    for name in ("steps", "transient", "chunk", "min_transient", "max_period", "block"):
-        o[name] = checks.integer(name, o[name], minimum=2 if name in ("steps", "block") else 1)
-    o["lyapunov_periods"] = checks.integer("lyapunov_periods", o["lyapunov_periods"], minimum=0)
-    for name in ("newton_tol", "candidate_tol", "reach_tol", "reach_floor", "lyapunov_band", "slip_band",
-                 "return_tol"):
-        o[name] = checks.number(name, o[name], positive=True)
-    return o
+    return checks.options(options, _DEFAULTS, dict(steps=2, transient=1, chunk=1, min_transient=1, max_period=1,
+                                                   block=2, lyapunov_periods=0))
 
 
 def rotation_sweep(body: Body, R, Theta, *, kind: str = "eight", p0=0.0, executor=None,

@@ -85,17 +85,9 @@ SLOW_FLOQUET = 0.9
 
 
 def _verdict_options(options: dict) -> dict:
-    unknown = set(options) - set(_DEFAULTS) - {"max_periods"}
-    if unknown:
-        raise TypeError(f"unknown option(s) {sorted(unknown)}; known: {sorted(set(_DEFAULTS) | {'max_periods'})}")
-    o = dict(_DEFAULTS, **{k: v for k, v in options.items() if k != "max_periods"})
-    for name in ("transient", "min_transient", "chunk", "lyapunov_periods", "min_lyapunov_periods"):
-        o[name] = checks.integer(name, o[name], minimum=0 if name in ("lyapunov_periods", "min_lyapunov_periods") else 1)
-    o["max_period"] = checks.integer("max_period", o["max_period"], minimum=1)
-    o["block"] = checks.integer("block", o["block"], minimum=2)
-    for name in ("newton_tol", "candidate_tol", "reach_tol", "reach_floor", "lyapunov_band", "slip_band",
-                 "h_verdict", "return_tol"):
-        o[name] = checks.number(name, o[name], positive=True)
+    o = checks.options(options, _DEFAULTS, dict(transient=1, min_transient=1, chunk=1, lyapunov_periods=0,
+                                                min_lyapunov_periods=0, max_period=1, block=2),
+                       extra=("max_periods",))
     mp = options.get("max_periods")
     if mp is not None:  # a total budget of periods per point: the transient first
         mp = checks.integer("max_periods", mp, minimum=2)

@@ -228,18 +228,10 @@ class _PeriodFlow:
 
 
 def _loop_options(options: dict) -> dict:
-    unknown = set(options) - set(LOOP_VERDICT_DEFAULTS)
-    if unknown:
-        raise TypeError(f"unknown option(s) {sorted(unknown)}; known: {sorted(LOOP_VERDICT_DEFAULTS)}")
-    o = dict(LOOP_VERDICT_DEFAULTS, **options)
-    for name, lo in (("steps", 16), ("transient", 1), ("periods", 24), ("block", 2), ("max_period", 1),
-                     ("newton_iter", 1)):
-        o[name] = checks.integer(name, o[name], minimum=lo)
+    o = checks.options(options, LOOP_VERDICT_DEFAULTS, dict(steps=16, transient=1, periods=24, block=2, max_period=1,
+                                                            newton_iter=1))
     if o["periods"] // o["block"] < 3:
         raise ValueError(f"periods ({o['periods']}) must hold at least 3 blocks of {o['block']} periods")
-    for name in ("candidate_tol", "newton_tol", "fd_step", "reach_tol", "reach_floor", "lyapunov_band",
-                 "slip_band", "position_band", "position_tol", "return_tol", "d0"):
-        o[name] = checks.number(name, o[name], positive=True)
     return o
 
 
