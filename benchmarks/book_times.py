@@ -12,6 +12,8 @@ the kernel, ``time.process_time`` (every thread of the kernel, numba's included)
 children it waited for (``resource.getrusage(RUSAGE_CHILDREN)``: the processes of a pool), around
 each cell; a page's total is the kernel's whole CPU time, its start and imports included.
 
+Every page has a budget of :data:`BUDGET` s of CPU (issue 28); the pages above it are flagged.
+
 Options: ``--min SECONDS`` lists the cells above that CPU or wall time (default 1 s);
 ``--json FILE`` also writes every cell's times.
 """
@@ -37,6 +39,9 @@ from preexecute import notebook_pages, toc_pages  # noqa: E402  (the build's one
 #: what a page's execution may read besides its own source
 BOOK_FILES = ("_config.yml", "_toc.yml", "references.bib")
 BOOK_DIRS = ("_static", "_ext")
+
+#: every page's budget, s of CPU on the idle 2-core machine (issue 28); a page above it is flagged
+BUDGET = 30.0
 
 _HOOK = "# book_times: hook"
 _SETUP = _HOOK + """
@@ -122,7 +127,8 @@ def main(argv: list[str] | None = None) -> int:
             res = run_page(book / f"{page}.md")
             res["page"] = page
             results.append(res)
-            print(f"{page:<28} wall {res['wall']:6.1f} s   CPU {res['cpu']:6.1f} s", flush=True)
+            over = f"   over its {BUDGET:g} s budget" if res["cpu"] > BUDGET else ""
+            print(f"{page:<28} wall {res['wall']:6.1f} s   CPU {res['cpu']:6.1f} s{over}", flush=True)
             for c in res["cells"]:
                 if max(c["wall"], c["cpu"]) >= args.min:
                     print(f"    cell {c['index']:>3}  wall {c['wall']:6.1f} s  CPU {c['cpu']:6.1f} s   "
@@ -130,6 +136,8 @@ def main(argv: list[str] | None = None) -> int:
     wall, cpu = sum(r["wall"] for r in results), sum(r["cpu"] for r in results)
     print(f"{'all pages, one after another':<28} wall {wall:6.1f} s   CPU {cpu:6.1f} s "
           f"(load average {os.getloadavg()[0]:.1f} at the end)")
+    over = [r["page"] for r in results if r["cpu"] > BUDGET]
+    print(f"pages over the {BUDGET:g} s budget: {', '.join(over) or 'none'}")
     if args.json:
         args.json.write_text(json.dumps(results, indent=1))
     return 0
