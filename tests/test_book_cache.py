@@ -36,6 +36,17 @@ def test_a_second_call_reads_what_the_first_computed_with_its_time(book):
     assert len(list((book / "_build" / ".cache").glob("_square-*.pkl"))) == 1
 
 
+def test_the_page_that_computed_a_result_is_named_beside_it(book, monkeypatch):
+    """The ``.page`` file names the page that computed (BOOK_PAGE), not one that read it."""
+    monkeypatch.setenv(book_cache.PAGE_VARIABLE, "chapters/04_limits")
+    book_cache.cached(_square, np.arange(3.0))
+    monkeypatch.setenv(book_cache.PAGE_VARIABLE, "report")
+    book_cache.cached(_square, np.arange(3.0))
+    book_cache.cached(_square, np.arange(5.0))
+    pages = sorted(f.read_text() for f in (book / "_build" / ".cache").glob("_square-*.page"))
+    assert pages == ["chapters/04_limits", "report"] and len(CALLS) == 2
+
+
 def test_other_arguments_compute_afresh(book):
     book_cache.cached(_square, np.arange(3.0))
     book_cache.cached(_square, np.arange(3.0), scale=2.0)

@@ -31,6 +31,9 @@ from pathlib import Path
 import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
+#: lib.machinery.cache.PAGE_VARIABLE (read without importing lib, whose import sets the
+#: environment the workers' kernels inherit)
+PAGE_VARIABLE = "BOOK_PAGE"
 #: pages that read what other pages cached: started after the others
 LAST = ("errata", "report", "intro")
 #: the kernels' environment: BLAS single-threaded. The book's matrices are small (2 x 2 to
@@ -91,6 +94,8 @@ def _execute(md: str, root: str, timeout: int, allow_errors: bool):
     from jupyter_cache.executors.utils import single_nb_execution
 
     nb = read_page(Path(md), Path(root))
+    # the page's name, for lib.machinery.cache to record which page computed a shared result
+    os.environ[PAGE_VARIABLE] = Path(md).relative_to(root).with_suffix("").as_posix()
     cpu = _children_cpu()
     res = single_nb_execution(nb, cwd=str(Path(md).parent), timeout=timeout, allow_errors=allow_errors,
                               meta_override=True)

@@ -7,7 +7,11 @@ result on disk, under ``_build/.cache`` of the book being built, keyed by the
 function, its arguments and the source of every module of ``lib``: a change to
 the library or to the arguments computes afresh (``make clean`` removes the cache).
 The time the computation took is kept with it (:func:`cached_timed`), so that a page
-quoting it quotes the computation, not the reading of the cache.
+quoting it quotes the computation, not the reading of the cache. Beside each result a file
+``.page`` names the page that computed it (the environment's ``BOOK_PAGE``, which
+``tools/preexecute.py`` sets for each page; empty outside a page): a test of the built book
+checks that the pages that read others' results (the report, the errata, the front page)
+computed none of the chapters' (:data:`PAGE_VARIABLE`).
 """
 
 from __future__ import annotations
@@ -27,7 +31,10 @@ try:
 except ImportError:  # not POSIX: no lock, a key may then be computed twice at once
     fcntl = None
 
-__all__ = ["cached", "cached_timed", "cache_dir"]
+__all__ = ["cached", "cached_timed", "cache_dir", "PAGE_VARIABLE"]
+
+#: the environment variable that names the page being executed (``chapters/04_limits``)
+PAGE_VARIABLE = "BOOK_PAGE"
 
 _LIB = Path(__file__).resolve().parents[1]          # the package lib/, every folder of it
 
@@ -139,6 +146,7 @@ def cached_timed(fn: Callable, *args, **kwargs) -> tuple[Any, float]:
         with tmp.open("wb") as fh:
             pickle.dump(out, fh)
         tmp.replace(path)
+        path.with_suffix(".page").write_text(os.environ.get(PAGE_VARIABLE, ""))
     return out
 
 
