@@ -1,6 +1,6 @@
 """Mutation testing of the library's core modules with mutmut 3 (run by hand, not in CI).
 
-    .venv/bin/python mutation/run.py                 # the seven core modules and the verdict procedure
+    .venv/bin/python mutation/run.py                 # every module of TESTS (see below for the time)
     .venv/bin/python mutation/run.py angles params   # some of them
 
 mutmut mutates the modules one small change at a time (an operator, a constant, a
@@ -12,10 +12,15 @@ tree), with mutmut's configuration written there as ``setup.cfg``, and writes th
 score and every surviving mutant, with its diff, to ``mutation/REPORT.md``. Each
 module is checked with the fast tests that cover it (:data:`TESTS`), not the whole
 suite. On 2 idle cores the six modules other than ``allocation`` take about 6 minutes,
-``allocation`` about 11 and the verdict procedure about 1; the run is niced.
+``allocation`` about 11 and the verdict procedure about 1; the run is niced. ``weighting.circle``
+(887 mutants) and the ten modules of ``lib/paper`` (4864 mutants) are far slower: on the shared,
+loaded machine the circle's run was stopped at 759 mutants after 35 minutes (its mutants of the
+solver and the Jacobian run every test of the file), and the paper's took 39 minutes; run
+them on their own (``MODULES=weighting.circle make mutation``).
 
 The survivors are then triaged by hand in REPORT.md: killed by a new test
-(``tests/test_core_mutants.py``) or listed as equivalent, with the reason.
+(``tests/test_core_mutants.py``, ``tests/test_paper_mutants.py``) or listed as equivalent, with
+the reason.
 """
 
 from __future__ import annotations
