@@ -328,3 +328,49 @@ def test_weight_limit_row_asks_for_the_papers_circle_just_either_side_of_the_lim
     assert out.status == status and out.merit == w and out.merit_label and out.note
     assert asked[0] == ("limit", Body(), Gains(), 2.0, math.pi / 4)
     assert asked[1:] == [("steady", Body(), Gains(), 2.0, math.pi / 4, (1.0, 1.0))] * 2
+
+
+# ------------------------------------------------------------------ weighting.circle: the solver's Newton polish
+
+def _rough_root(shift, success):
+    """scipy's root, then its answer moved by ``shift`` (m, m, rad) and its success flag set."""
+    from scipy.optimize import root as real_root
+
+    def rough(g, x0, method, tol):
+        sol = real_root(g, x0, method=method, tol=tol)
+        sol.x, sol.success = sol.x + shift, success
+        return sol
+    return rough
+
+
+def test_solver_polishes_a_rough_root_by_newton_and_refuses_a_failed_one(monkeypatch):
+    # hybr at tol 1e-14 always lands below the polish's 1e-13 on the real loop, so the Newton
+    # polish never runs there; here the root comes back 1e-6 off
+    loop = C._loop(BODY, GAINS, R, THETA, (1.0, 1.0, 1.0))
+    guess = C._start(BODY, R, THETA)
+    exact = C._solve(loop, THETA, guess)
+    monkeypatch.setattr(C, "root", _rough_root(1e-6, True))
+    x = C._solve(loop, THETA, guess)
+    # accuracy: Newton from 1e-6 converges quadratically in 3 steps (difference Jacobian, step
+    # 1e-6) to the polish's residual 1e-13 times |J^-1| = 19 (measured 2e-16)
+    assert x is not None and np.max(np.abs(x - exact)) < 1e-11
+    monkeypatch.setattr(C, "root", _rough_root(1e-6, False))
+    assert C._solve(loop, THETA, guess) is None          # failed, and its residual above 1e-11
+    monkeypatch.setattr(C, "root", _rough_root(0.0, False))
+    x = C._solve(loop, THETA, guess)                      # "failed", but its residual below 1e-11
+    assert x is not None and np.max(np.abs(x - exact)) < 1e-11  # accuracy: as above
+
+
+def test_sweep_columns_do_not_depend_on_which_row_comes_first(monkeypatch):
+    # a weight past the end of the branch given first: its row still has every column, in order
+    _branch_ends(monkeypatch, 0.5)
+    d = C.circle_weight_sweep(BODY, GAINS, R, THETA, [0.7, 0.2])
+    assert d.columns.tolist() == ["w_phi", "radial", "tangential", "position_error", "heading", "max_real",
+                                  "max_imag", "stable"]
+
+
+def test_sweep_max_imag_is_that_of_the_leading_eigenvalue(monkeypatch):
+    # a real leading eigenvalue with a complex pair behind it: max_imag is 0, not the pair's
+    _spectrum(monkeypatch, lambda w: [w - 0.8, complex(-1.0, 0.5), complex(-1.0, -0.5), -2.0, -3.0, -4.0])
+    d = C.circle_weight_sweep(BODY, GAINS, R, THETA, [0.5])
+    assert d.max_imag[0] == 0.0 and d.max_real[0] == 0.5 - 0.8  # exact: the synthetic spectrum's values
