@@ -1,6 +1,6 @@
 """Mutation testing of the library's core modules with mutmut 3 (run by hand, not in CI).
 
-    .venv/bin/python mutation/run.py                 # the seven core modules and the verdict procedure
+    .venv/bin/python mutation/run.py                 # every module of TESTS (see below for the time)
     .venv/bin/python mutation/run.py angles params   # some of them
 
 mutmut mutates the modules one small change at a time (an operator, a constant, a
@@ -12,10 +12,15 @@ tree), with mutmut's configuration written there as ``setup.cfg``, and writes th
 score and every surviving mutant, with its diff, to ``mutation/REPORT.md``. Each
 module is checked with the fast tests that cover it (:data:`TESTS`), not the whole
 suite. On 2 idle cores the six modules other than ``allocation`` take about 6 minutes,
-``allocation`` about 11 and the verdict procedure about 1; the run is niced.
+``allocation`` about 11 and the verdict procedure about 1; the run is niced. ``weighting.circle``
+(887 mutants) and the ten modules of ``lib/paper`` (4864 mutants) are far slower: on the shared,
+loaded machine the circle's run was stopped at 759 mutants after 35 minutes (its mutants of the
+solver and the Jacobian run every test of the file), and the paper's took 39 minutes; run
+them on their own (``MODULES=weighting.circle make mutation``).
 
 The survivors are then triaged by hand in REPORT.md: killed by a new test
-(``tests/test_core_mutants.py``) or listed as equivalent, with the reason.
+(``tests/test_core_mutants.py``, ``tests/test_paper_mutants.py``) or listed as equivalent, with
+the reason.
 """
 
 from __future__ import annotations
@@ -33,6 +38,23 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 VENV_BIN = Path(sys.executable).parent
 
+#: the errata rows' checks, on the row's own forms and on falsifying ones
+PAPER_ERRATA = ["tests/test_errata.py", "tests/test_errata_falsifiable.py"]
+#: the report's rules that need no row's real evidence (tests/test_report.py without its
+#: parametrized test, which runs every row's check on the book's computations)
+REPORT_RULES = [f"tests/test_report.py::{t}" for t in (
+    "test_outcome_rejects_unknown_status_and_non_finite_merit",
+    "test_the_front_page_states_report_rows_with_the_status_each_row_claims",
+    "test_legend_status_is_the_reports_legend",
+    "test_equation_numbers_are_read_from_the_rows_head",
+    "test_rows_with_a_failing_printed_equation_are_not_reproduced")]
+#: the report rows whose real check takes a second or two (measured on the loaded machine), each
+#: run as in the book; the others recompute a flow map, a sweep or a symbolic determinant (4 s to
+#: minutes each), and every mutant of the rows' shared code (items, outcome) would run them all
+REPORT_ROWS = [f"tests/test_report.py::test_report_row_status_is_decided_by_its_check[{k}]" for k in (
+    "eq2-4", "eq5-10", "eq6", "eq21", "count", "thm6", "thm7", "stlc", "eq25-26", "eq27-28", "eq29-30",
+    "eq31", "table", "fig2", "eq32", "eq33", "p0", "eq34-35", "eq36", "eq37", "fourier")]
+
 #: the core modules and the fast test files (or test ids) that cover each
 TESTS = {
     "params": ["tests/test_params.py", "tests/test_model.py", "tests/test_control.py"],
@@ -48,9 +70,25 @@ TESTS = {
     "dynamics.verdicts": ["tests/test_verdict_procedure.py"],
     "dynamics.orbit_search": ["tests/test_verdict_procedure.py"],
     "dynamics.statistics": ["tests/test_verdict_procedure.py"],
+    # the paper's errata and report (issue 28): each errata row's check run on its own forms and on
+    # falsifying ones, the extension rows fed synthetic evidence, the report's own rules, and the
+    # report rows whose real check is cheap (REPORT_ROWS); the other rows' checks recompute the
+    # book's flow maps and sweeps, minutes per mutant, and are left out
+    "paper.errata": PAPER_ERRATA + REPORT_RULES,
+    "paper.verdicts": PAPER_ERRATA,
+    "paper.model_errata": PAPER_ERRATA + ["tests/test_symbolic.py"],
+    "paper.tracking_errata": PAPER_ERRATA,
+    "paper.rotation_errata": PAPER_ERRATA,
+    "paper.reading_errata": PAPER_ERRATA,
+    "paper.outcomes": REPORT_RULES + ["tests/test_report_falsifiable.py"],
+    "paper.extensions": ["tests/test_report_falsifiable.py"],
+    "paper.report": REPORT_RULES + REPORT_ROWS,
+    "paper.findings": REPORT_RULES,
+    # the circle's steady motion under the weighted allocation (Chapter 6)
+    "weighting.circle": ["tests/test_weighted_circle.py"],
 }
 #: tests written to kill survivors: always run
-ALWAYS = ["tests/test_core_mutants.py"]
+ALWAYS = ["tests/test_core_mutants.py", "tests/test_paper_mutants.py"]
 #: helpers the test files import
 SUPPORT = ["tests/conftest.py", "tests/flows.py"]
 
