@@ -40,7 +40,7 @@ test: $(STAMP)
 	  then echo "Reusing the current build in _build"; : > _build/book.out; \
 	  else echo "Building the book in the background (output: _build/book.out)"; \
 	       $(MAKE) --no-print-directory book > _build/book.out 2>&1 & fi; \
-	NUMBA_NUM_THREADS=1 OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 nice -n 10 $(BIN)/python -m pytest -n 2 -m "not book and not browser"; fast=$$?; \
+	NUMBA_NUM_THREADS=1 OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 nice -n 10 $(BIN)/python -m pytest -n 2 --dist worksteal -m "not book and not browser"; fast=$$?; \
 	wait; \
 	BOOK_REBUILD= $(BIN)/python -m pytest -m "book or browser"; slow=$$?; \
 	test $$fast = 0 && test $$slow = 0
@@ -58,7 +58,7 @@ PORTABLE_ENV := NUMBA_CPU_NAME=generic NUMBA_CACHE_DIR=$(CURDIR)/_build/numba-ge
 
 test-portable: $(STAMP)
 	@mkdir -p _build/numba-generic
-	$(PORTABLE_ENV) nice -n 10 $(BIN)/python -m pytest -n 2 -m "not book and not browser" -p no:cacheprovider
+	$(PORTABLE_ENV) nice -n 10 $(BIN)/python -m pytest -n 2 --dist worksteal -m "not book and not browser" -p no:cacheprovider
 
 benchmark: $(STAMP)
 	$(BIN)/python benchmarks/bench_switched.py
