@@ -220,7 +220,7 @@ def pages(server) -> dict[str, Page]:
     if not Path(CHROMIUM).exists():
         pytest.skip(f"Debian's chromium is not installed ({CHROMIUM} missing): browser test skipped; "
                     "run .ci/run or `apt-get install chromium` to enable it")
-    from playwright.sync_api import sync_playwright
+    from playwright.sync_api import TimeoutError as PlaywrightTimeout, sync_playwright
 
     read: dict[str, Page] = {}
     tic = time.perf_counter()
@@ -236,8 +236,15 @@ def pages(server) -> dict[str, Page]:
             page.on("request", lambda r, seen=seen: seen.requests.append(r.url))
             page.on("requestfailed", lambda r, seen=seen: seen.failed.append(r.url))
             page.goto(url, wait_until="networkidle")
-            if page.evaluate("() => !!(window.MathJax && MathJax.startup && MathJax.startup.promise)"):
-                page.evaluate("() => MathJax.startup.promise")
+            # a page that includes MathJax: wait until it has started and typeset (on a heavy page,
+            # Chapter 4's plotly figures, the deferred script may still be running at network idle)
+            if page.evaluate("() => !!document.querySelector('script[src*=\"mathjax\"]')"):
+                try:
+                    page.wait_for_function("() => !!(window.MathJax && MathJax.startup && MathJax.startup.promise)",
+                                           timeout=60_000)
+                    page.evaluate("() => MathJax.startup.promise")
+                except PlaywrightTimeout:
+                    pass                                  # the math test then says MathJax did not load
             page.wait_for_function("() => Array.from(document.images).every(i => i.complete)")
             seen.data = page.evaluate(READ_PAGE)
             page.close()
