@@ -31,9 +31,6 @@ from pathlib import Path
 import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
-#: lib.machinery.cache.PAGE_VARIABLE (read without importing lib, whose import sets the
-#: environment the workers' kernels inherit)
-PAGE_VARIABLE = "BOOK_PAGE"
 #: pages that read what other pages cached: started after the others
 LAST = ("errata", "report", "intro")
 #: the kernels' environment: BLAS single-threaded. The book's matrices are small (2 x 2 to
@@ -92,6 +89,8 @@ def _execute(md: str, root: str, timeout: int, allow_errors: bool):
     """Execute one page in its folder (in a worker process); the notebook, the error's text,
     the wall time and the kernel's CPU time (s)."""
     from jupyter_cache.executors.utils import single_nb_execution
+
+    from lib.machinery.cache import PAGE_VARIABLE
 
     nb = read_page(Path(md), Path(root))
     # the page's name, for lib.machinery.cache to record which page computed a shared result
