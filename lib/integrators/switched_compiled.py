@@ -152,9 +152,12 @@ def _one_sided(P, lim, t, s):
 @numba.njit(cache=True)
 def _step(P, lim, mode, t, s, h, A, b, c, K, ys, out, g):
     """One explicit Runge-Kutta step of size h from (t, s) into ``out``; the event
-    functions at its end into ``g``."""
+    functions at its end into ``g``, the rates there into ``ys``. ``K[0]`` must hold the
+    rates at (t, s) under ``mode`` already (the first stage, c[0] = 0, does not depend on
+    h): the caller has them from the end of the step before, or from the field evaluated
+    after an event, or from the first try of this step (``_advance``)."""
     n_st = c.size
-    for i in range(n_st):
+    for i in range(1, n_st):
         for q in range(6):
             ys[q] = s[q]
         for j in range(i):
@@ -345,10 +348,16 @@ def _new_mode(P, lim, mode, t, s, g0, g2, stats):
 def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2, yh, fh, gh, stats):
     """Integrate s (in place) over n_steps steps of size h from t0; returns the final mode.
     stats: [crossings, slides, time sliding, events, failed, steps locating events]."""
-    _field(P, lim, mode, t0, s, ys, g0)
+    # K[0] holds the rates at (t, s) under the mode at every step's start (see _step): from the
+    # field evaluated here or after an event, or from the end of the step before when that
+    # step ended at the same time to the bit (t + dt == t_end), else evaluated again
+    _field(P, lim, mode, t0, s, K[0], g0)
+    t_k0 = t0
     for j in range(n_steps):
         t = t0 + j * h
         t_end = t0 + (j + 1) * h
+        if t_k0 != t:
+            _field(P, lim, mode, t, s, K[0], gh)
         n_ev = 0
         while True:
             dt = t_end - t
@@ -360,6 +369,9 @@ def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2
                 if mode == 0:
                     stats[2] += dt
                 _copy(y1, g1, s, g0)
+                for q in range(6):
+                    K[0, q] = ys[q]
+                t_k0 = t + dt
                 t = t_end
                 break
             hi = _locate(P, lim, mode, t, s, dt, first, A, b, c, K, ys, y1, y2, g0, g1, g2, yh, fh, gh, stats)
@@ -374,7 +386,8 @@ def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2
                 stats[4] = 1.0
                 return mode
             mode = _new_mode(P, lim, mode, t, s, g0, g2, stats)
-            _field(P, lim, mode, t, s, ys, g0)
+            _field(P, lim, mode, t, s, K[0], g0)
+            t_k0 = t
         for q in range(6):
             if not math.isfinite(s[q]):
                 stats[4] = 2.0
