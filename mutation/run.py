@@ -71,18 +71,19 @@ TESTS = {
     "dynamics.orbit_search": ["tests/test_verdict_procedure.py"],
     "dynamics.statistics": ["tests/test_verdict_procedure.py"],
     # the paper's errata and report (issue 28): each errata row's check run on its own forms and on
-    # falsifying ones, the extension rows fed synthetic evidence, the report's own rules, and the
-    # report rows whose real check is cheap (REPORT_ROWS); the other rows' checks recompute the
-    # book's flow maps and sweeps, minutes per mutant, and are left out
+    # falsifying ones, every report row (on the paper and the extensions) fed synthetic evidence
+    # that passes or breaks each clause in turn, the report's own rules, and the report rows whose
+    # real check is cheap (REPORT_ROWS); the other rows' real checks recompute the book's flow maps
+    # and sweeps, minutes per mutant, and run only on their synthetic evidence here
     "paper.errata": PAPER_ERRATA + REPORT_RULES,
     "paper.verdicts": PAPER_ERRATA,
     "paper.model_errata": PAPER_ERRATA + ["tests/test_symbolic.py"],
     "paper.tracking_errata": PAPER_ERRATA,
     "paper.rotation_errata": PAPER_ERRATA,
     "paper.reading_errata": PAPER_ERRATA,
-    "paper.outcomes": REPORT_RULES + ["tests/test_report_falsifiable.py"],
+    "paper.outcomes": REPORT_RULES + ["tests/test_report_falsifiable.py", "tests/test_report_paper_falsifiable.py"],
     "paper.extensions": ["tests/test_report_falsifiable.py"],
-    "paper.report": REPORT_RULES + REPORT_ROWS,
+    "paper.report": REPORT_RULES + REPORT_ROWS + ["tests/test_report_paper_falsifiable.py"],
     "paper.findings": REPORT_RULES,
     # the circle's steady motion under the weighted allocation (Chapter 6)
     "weighting.circle": ["tests/test_weighted_circle.py"],

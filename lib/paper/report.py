@@ -79,9 +79,9 @@ def _corrected_by(key: str, merit: float, merit_label: str, note: str = "", evid
                    merit_label, note or "printed form fails, corrected form holds (see the errata row)", erratum=key)
 
 
-def _refuted_by(key: str, merit: float, merit_label: str, note: str) -> Outcome:
+def _refuted_by(key: str, merit: float, merit_label: str, note: str, evidence: bool = True) -> Outcome:
     v = verdict(key)                 # KeyError for a key that is not an errata row
-    return Outcome(legend_status(v.confirmed, counterexample=True), merit, merit_label, note, erratum=key,
+    return Outcome(legend_status(evidence and v.confirmed, counterexample=True), merit, merit_label, note, erratum=key,
                    counterexample=True)
 
 
@@ -194,7 +194,7 @@ def _check_rank_claim() -> Outcome:
     return _corrected_by("sec3-rank-condition", 0.0 if residual == 0 else 1.0,
                          "symbolic residual of det C (derived columns) against a^2 (a m v2 - I_C omega)/(I_C^3 m^4)",
                          "det C vanishes exactly where omega = a m v2 / I_C with the derived brackets; "
-                         "with the printed brackets of (21) it does not")
+                         "with the printed brackets of (21) it does not", evidence=residual == 0)
 
 
 def _check_thm6() -> Outcome:
@@ -208,7 +208,7 @@ def _check_thm7() -> Outcome:
     return _refuted_by("thm7-drift", drift, "|f(q)| at a moving state: the drift is not zero",
                        "misapplied: Theorem 7 is for systems without drift; the conclusion of Sec. 3 cites it for "
                        "(5), which has one, and with a drift accessibility implies no controllability "
-                       "(counterexample in the errata row)")
+                       "(counterexample in the errata row)", evidence=drift > 0)
 
 
 def _check_conclusion() -> Outcome:
