@@ -374,3 +374,41 @@ def test_sweep_max_imag_is_that_of_the_leading_eigenvalue(monkeypatch):
     _spectrum(monkeypatch, lambda w: [w - 0.8, complex(-1.0, 0.5), complex(-1.0, -0.5), -2.0, -3.0, -4.0])
     d = C.circle_weight_sweep(BODY, GAINS, R, THETA, [0.5])
     assert d.max_imag[0] == 0.0 and d.max_real[0] == 0.5 - 0.8  # exact: the synthetic spectrum's values
+
+
+def test_circle_checks_name_the_bad_type_and_each_gain_and_size():
+    with pytest.raises(TypeError, match=r"^body must be a lib.params.Body, got str$"):
+        C.circle_steady_state("body", GAINS, R, THETA)
+    with pytest.raises(TypeError, match=r"^gains must be a lib.params.Gains, got str$"):
+        C.circle_steady_state(BODY, "gains", R, THETA)
+    equal = r"^the circle's steady motion needs equal gains on x and y .* not autonomous in the rotating frame$"
+    for bad in (Gains(kp=(5.2, 5.0, 5.2)), Gains(kv=(3.2, 3.0, 3.2))):     # x and y unequal: kp, then kv
+        with pytest.raises(ValueError, match=equal):
+            C.circle_steady_state(BODY, bad, R, THETA)
+    # the heading's gains (third components) may differ: (23)'s phi row is not allocated
+    free = C.circle_steady_state(BODY, Gains(kp=(5.2, 5.2, 1.0), kv=(GAINS.kv[0],) * 2 + (1.0,)), R, THETA)
+    assert free.eigenvalues.shape == (6,)
+    for v in (True, np.array([1.0, 2.0])):                  # a bool, an array: each clause of the size check
+        with pytest.raises(ValueError, match=r"^R must be a positive finite number"):
+            C.circle_steady_state(BODY, GAINS, v, THETA)
+        with pytest.raises(ValueError, match=r"^Theta must be a positive finite number"):
+            C.circle_steady_state(BODY, GAINS, R, v)
+
+
+def test_steady_state_eigenvalues_put_a_pairs_positive_imaginary_part_first():
+    # at w_phi = 3, just below the limit, the two leading pairs are complex
+    lam = C.circle_steady_state(BODY, GAINS, R, THETA, (1.0, 1.0, 3.0)).eigenvalues
+    assert np.all(np.diff(lam.real) <= 0)
+    for k in (0, 2):
+        assert lam[k].imag > 0.1 and lam[k + 1] == np.conj(lam[k])   # exact: eigvals returns exact conjugates
+
+
+def test_solver_refuses_a_point_the_polish_cannot_bring_to_a_root(monkeypatch):
+    # scipy's root "succeeds" 1e-6 off, and a Jacobian ten times too steep makes Newton's three
+    # steps shrink the residual by 0.9 each: about 7e-7, above the final refusal's 1e-9
+    loop = C._loop(BODY, GAINS, R, THETA, (1.0, 1.0, 1.0))
+    guess = C._start(BODY, R, THETA)
+    monkeypatch.setattr(C, "root", _rough_root(1e-6, True))
+    real_jacobian = C._jacobian
+    monkeypatch.setattr(C, "_jacobian", lambda *a, **kw: 10.0 * real_jacobian(*a, **kw))
+    assert C._solve(loop, THETA, guess) is None

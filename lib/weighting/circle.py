@@ -66,7 +66,8 @@ class CircleSteadyState:
     ``radial`` and ``tangential``: the position error in the rotating frame (m; radial
     positive outwards, tangential positive along the motion for Theta > 0); ``heading``:
     p = phi - phi_d (rad, unwrapped); ``eigenvalues``: the six eigenvalues of the
-    linearisation (1/s), sorted by decreasing real part; ``state``: the equilibrium
+    linearisation (1/s), sorted by decreasing real part (a complex pair with its positive
+    imaginary part first); ``state``: the equilibrium
     y = (xi, eta, p, 0, 0, 0) (m, m, rad); ``weights``: (w_x, w_y, w_phi)."""
 
     radial: float
