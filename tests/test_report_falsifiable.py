@@ -182,16 +182,25 @@ def test_weight_limit_row_fails_with_each_clause(monkeypatch, w, below, above, s
 # ------------------------------------------------------------------ percussion: the circle and the map
 
 @pytest.mark.parametrize("radius_gap, lock, rate, status", [
-    (0.0, 0.10, -15.0, "extended"),
-    (1e-6, 0.10, -15.0, "not reproducible"),       # C's closed-form circle is not the paper's R
-    (0.0, 0.20, -15.0, "not reproducible"),        # the lock radius above the paper's (36)
-    (0.0, 0.10, 0.5, "not reproducible"),          # the heading's rate not negative
+    (0.0, None, None, "extended"),                 # the real closed forms
+    (1e-6, None, None, "not reproducible"),        # C's closed-form circle is not the paper's R
+    (0.0, 1.01, None, "not reproducible"),         # the lock radius just above the paper's (36)
+    (0.0, None, 0.5, "not reproducible"),          # the heading's rate not negative
 ])
 def test_percussion_circle_row_fails_with_each_clause(monkeypatch, radius_gap, lock, rate, status):
-    steady = lambda body, R, Theta: SimpleNamespace(radius_C=ext.R0 * (1 + radius_gap), rate=rate)  # noqa: E731
-    assert _status(monkeypatch, "percussion-circle", circle_equilibria=lambda body, R, th: (1.15, 4.3),
-                   circle_steady_motion=steady, circle_lock_radius=lambda body, th: lock,
-                   circle_critical_radius=lambda body, th: 0.15) == status
+    # the closed forms themselves (instant), each clause broken by a wrapper: a check that puts P
+    # on another circle, or asks at another rate or radius, is caught by the first case
+    real_motion, real_lock = ext.circle_steady_motion, ext.circle_lock_radius
+
+    def motion(body, R, Theta):
+        st = real_motion(body, R, Theta)
+        return SimpleNamespace(radius_C=st.radius_C * (1 + radius_gap), rate=st.rate if rate is None else rate)
+
+    def lock_radius(body, th):
+        return real_lock(body, th) if lock is None else lock * ext.circle_critical_radius(body, th)
+
+    assert _status(monkeypatch, "percussion-circle", circle_steady_motion=motion,
+                   circle_lock_radius=lock_radius) == status
 
 
 @pytest.mark.parametrize("regime, lost, status", [
