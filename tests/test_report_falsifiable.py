@@ -130,6 +130,8 @@ def _fig5(bad=None):
 
 def _prediction(err=0.029, slips=False):
     def predict(body, R, Theta):
+        # the band's slowest rate, at its points in the map's order
+        assert list(R) == [1.0, 2.0] and list(Theta) == [0.05, 0.05]
         return SimpleNamespace(corrected_range=np.array([0.5, 0.4 + err]), corrected_slips=np.array([False, slips]))
     return predict
 
@@ -160,8 +162,13 @@ def test_slow_eights_row_fails_with_each_clause_and_each_point_of_the_band(monke
 def test_window_row_fails_with_each_clause(monkeypatch, width, th, gap, status):
     body = ext.Body()
     threshold = math.sqrt(body.c_phi / (body.I * th)) / (1.0 + gap)
+
+    def window(body_, theta):
+        assert body_ == body and theta == math.pi / 4              # the paper's rate
+        return 1.0, 1.0 + width
+
     assert _status(monkeypatch, "window", cached=lambda fn, *a, **kw: fn(*a, **kw),     # no build cache
-                   bistable_window=lambda body, theta: (1.0, 1.0 + width),
+                   bistable_window=window,
                    window_closing_rate=lambda body: th, torque_pendulum_threshold=lambda: threshold) == status
 
 
