@@ -37,6 +37,23 @@ def _cache(**frames):
     return lambda fn, *args, **kw: frames[fn.__name__]
 
 
+def _same(a, b) -> bool:
+    """Equal arguments: arrays element by element, sequences item by item, else ``==``."""
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return np.shape(a) == np.shape(b) and bool(np.all(np.asarray(a) == np.asarray(b)))
+    if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
+    return type(a) is type(b) and a == b
+
+
+def _asks(value, *expected):
+    """A fake that returns ``value`` when called with exactly the arguments ``expected``."""
+    def fake(*args):
+        assert _same(args, expected), f"called with {args!r}, expected {expected!r}"
+        return value
+    return fake
+
+
 # ------------------------------------------------------------------ limit-lyapunov: per angle group
 
 def _horizons(changes=(0.17, 0.17), ratios=(49.0, 49.0)):
@@ -84,10 +101,22 @@ def _mirror_frame(paper=("A", False, 2.56), mirror="A'"):
     (("A", False, 2.56), "A'", 1e-6, "not reproducible"),      # the loop not symmetric
 ])
 def test_limit_mirror_row_fails_with_each_of_its_clauses(monkeypatch, paper, mirror, defect, status):
-    got = _status(monkeypatch, "limit-mirror", cached=_cache(start_attractors=_mirror_frame(paper, mirror)),
-                  heading_offset_starts=lambda offsets: np.zeros((len(offsets), 6)),
-                  mirrored_start=lambda *a: np.zeros((1, 6)),
-                  mirror_defect=lambda *a: np.array([0.0, defect]))
+    # every call asks for Chapter 4's case: the eight from the paper's start, a 90 deg limit, no
+    # cap, its 12 heading offsets and the mirrored start, a defect over 4 periods
+    body, gains, ref = ext.Body(), ext.Gains(), ext.eight(2.0, math.pi / 4)
+    s0 = np.concatenate([ext.PAPER_Z0, ext.PAPER_DZ0])
+    case = (body, gains, ref, math.radians(90), None)
+    offsets = np.radians(np.arange(-180, 180, 30))
+    starts = np.vstack([np.arange(72.0).reshape(12, 6), -np.ones((1, 6))])
+
+    def frames(fn, *args):
+        assert fn.__name__ == "start_attractors" and _same(args, case + (starts,))
+        return _mirror_frame(paper, mirror)
+
+    got = _status(monkeypatch, "limit-mirror", cached=frames,
+                  heading_offset_starts=_asks(starts[:12], offsets),
+                  mirrored_start=_asks(starts[12:], *case, s0),
+                  mirror_defect=_asks(np.array([0.0, defect]), *case, s0, 4))
     assert got == status
 
 

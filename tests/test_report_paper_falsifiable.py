@@ -22,12 +22,14 @@ import pandas as pd
 import pytest
 import sympy as sp
 
+from lib.allocation import Limits
 from lib.limits.torus import NS_START_CAP
 from lib.paper import errata, report
 from lib.paper.verdicts import Verdict
-from lib.params import Body
+from lib.params import Body, Gains
 from lib.rotation.circle import circle_critical_radius, circle_eigenvalues
 from lib.rotation.equations import derive_rotation_equation
+from lib.simulate import Integration
 from lib.symbolic import derive_body_frame
 from lib import trajectories
 
@@ -37,7 +39,13 @@ CONFIRMED = Verdict(printed_holds=False, corrected_holds=True, detail="")
 
 
 def _status(monkeypatch, key, verdicts=None, **fakes):
-    """(status, errata keys asked) of report row ``key`` with the module names ``fakes``
+    """(status, errata keys asked) of report row ``key`` (:func:`_outcome`)."""
+    out, asked = _outcome(monkeypatch, key, verdicts, **fakes)
+    return out.status, asked
+
+
+def _outcome(monkeypatch, key, verdicts=None, **fakes):
+    """(outcome, errata keys asked) of report row ``key`` with the module names ``fakes``
     replaced; every errata verdict is a confirmed one unless ``verdicts`` (key -> Verdict)
     says otherwise."""
     asked = []
@@ -51,7 +59,7 @@ def _status(monkeypatch, key, verdicts=None, **fakes):
     for name, value in fakes.items():
         assert hasattr(report, name), name   # a fake for a name the check no longer reads
         monkeypatch.setattr(report, name, value)
-    return ITEMS[key].check().status, asked
+    return ITEMS[key].check(), asked
 
 
 def _cache(**values):
@@ -137,8 +145,9 @@ def _determinant(kind):
 @pytest.mark.parametrize("kind, status", [("derived", "corrected"), ("sign", "not reproducible"),
                                           ("factor", "not reproducible"), ("set", "not reproducible")])
 def test_rank_row_needs_the_derived_determinant(monkeypatch, kind, status):
-    status_, asked = _status(monkeypatch, "rank", cached=_cache(rank_determinants={"derived": _determinant(kind)}))
-    assert status_ == status and asked == ["sec3-rank-condition"]
+    out, asked = _outcome(monkeypatch, "rank", cached=_cache(rank_determinants={"derived": _determinant(kind)}))
+    assert out.status == status and asked == ["sec3-rank-condition"]
+    assert out.merit == (0.0 if kind == "derived" else 1.0)      # exact: the residual's flag
 
 
 # ------------------------------------------------------------------ Secs. 4-5: the tracking law
@@ -161,8 +170,12 @@ def test_error_equation_row_fails_on_the_x_or_the_y_row(monkeypatch, off, status
     exact = res.error.copy()
     if off is not None:
         exact[300, off[0]] += off[1]
-    got, asked = _status(monkeypatch, "eq23-24", _circle_run=lambda: res,
-                         error_dynamics_solution=lambda body, gains, e0, de0, t: exact)
+    def solution(body, gains, e0, de0, t):      # (24) from the run's own start, at its own times
+        assert (body, gains) == (Body(), Gains()) and t is res.t
+        assert np.array_equal(e0, res.error[0]) and np.array_equal(de0, res.derror[0])
+        return exact
+
+    got, asked = _status(monkeypatch, "eq23-24", _circle_run=lambda: res, error_dynamics_solution=solution)
     assert got == status and asked == ["eq24-rows"]
 
 
@@ -218,7 +231,8 @@ class _Shifted:
         return self.ref.dz(t)
 
 
-@pytest.mark.parametrize("which, dphi", [(None, 0.0), ("circle", 2e-12), ("eight", 2e-12)])
+@pytest.mark.parametrize("which, dphi", [(None, 0.0), ("circle", 2e-12), ("eight", 2e-12),
+                                         ("eight", math.pi)])      # facing backwards: not the tangent
 def test_reference_row_fails_with_a_heading_off_the_tangent_on_either_path(monkeypatch, which, dphi):
     fakes = {name: (lambda name=name: _Shifted(getattr(trajectories, name)(), dphi if name == which else 0.0))
              for name in ("circle", "eight")}
@@ -249,7 +263,8 @@ def test_circle_figure_row_needs_a_constant_rotation_error_after_50_s(monkeypatc
     p = np.full(601, 0.25)                     # samples every 0.1 s: index 500 is t = 50 s
     if where is not None:
         p[where] += jump
-    assert _status(monkeypatch, "fig2", _circle_run=lambda: _run(p=p))[0] == status
+    out = _outcome(monkeypatch, "fig2", _circle_run=lambda: _run(p=p))[0]
+    assert out.status == status and out.merit == p[-1]       # exact: the steady error, the last sample
 
 
 @pytest.mark.parametrize("period, rng, circle_rng, status", [
@@ -262,20 +277,29 @@ def test_circle_figure_row_needs_a_constant_rotation_error_after_50_s(monkeypatc
 def test_eight_figure_row_fails_with_each_clause(monkeypatch, period, rng, circle_rng, status):
     asked = []
 
+    circle_run = _run()
+
     def attractor(body, kind, R, th):
-        asked.append((kind, R, th))
+        asked.append((body, kind, R, th))
         return SimpleNamespace(period=period, range=rng)
 
-    got = _status(monkeypatch, "fig3", rotation_attractor=attractor, _circle_run=lambda: _run(),
-                  steady_summary=lambda res, n: {"p_range": circle_rng})[0]
-    assert got == status and asked == [("eight", 2.0, np.pi / 4)]
+    def summary(res, n):              # the circle's last two periods
+        assert res is circle_run and n == 2.0
+        return {"p_range": circle_rng}
+
+    out = _outcome(monkeypatch, "fig3", rotation_attractor=attractor, _circle_run=lambda: circle_run,
+                   steady_summary=summary)[0]
+    assert out.status == status and out.merit == rng and asked == [(Body(), "eight", 2.0, np.pi / 4)]
 
 
 def _capped(amplitude=0.05, drift=0.0, n_periods=10, per=200):
+    """Fig. 4's run: a position error of the given amplitude, periodic but for a drift in the last
+    period, split between x (0.6) and y (0.8); the heading error (column 2) is large, and not
+    the position's."""
     t = np.arange(n_periods * per + 1) / per
     e = amplitude * np.abs(np.sin(np.pi * t))
     e[-per:] += drift * np.sin(np.pi * t[-per:]) ** 2
-    error = np.column_stack([e, np.zeros_like(e), np.zeros_like(e)])
+    error = np.column_stack([0.6 * e, 0.8 * e, 3.0 + np.zeros_like(e)])
     return SimpleNamespace(t=t, error=error)
 
 
@@ -287,7 +311,13 @@ def _capped(amplitude=0.05, drift=0.0, n_periods=10, per=200):
 ])
 def test_capped_eight_row_needs_a_non_zero_periodic_error(monkeypatch, amplitude, drift, status):
     res = _capped(amplitude, drift)
-    assert _status(monkeypatch, "fig4", cached=_cache(run=res))[0] == status
+
+    def run(fn, *args, **kw):        # Chapter 4's call: ten periods of the eight, 4 N cap, rtol 1e-9
+        assert fn is report.run and args == (Body(), Gains(), "eight", 2.0, np.pi / 4, 10)
+        assert kw == dict(limits=Limits(force=4.0), integration=Integration(rtol=1e-9, atol=1e-9))
+        return res
+
+    assert _status(monkeypatch, "fig4", cached=run)[0] == status
 
 
 def _sweep(**at30):
@@ -332,6 +362,7 @@ QP = dict(regime="quasiperiodic", lyapunov=0.0002, lyapunov_stderr=0.0001, floqu
     (dict(lyapunov=-0.0077 / 8.0), dict(), "not reproducible"),        # |lambda| T above 0.0075 (T = 8 s)
     (dict(lyapunov=0.0073 / 8.0), dict(), "reproduced"),
     (dict(lyapunov_stderr=0.0026 / 8.0), dict(), "not reproducible"),  # 3 SE T above 0.0075
+    (dict(lyapunov_stderr=0.0024 / 8.0), dict(), "reproduced"),
     (dict(floquet=1.1), dict(), "not reproducible"),                    # the orbit inside not repelling
     (dict(), dict(modulus_below=1.0), "not reproducible"),
     (dict(), dict(modulus_above=1.0), "not reproducible"),
@@ -342,13 +373,24 @@ QP = dict(regime="quasiperiodic", lyapunov=0.0002, lyapunov_stderr=0.0001, floqu
 def test_quasi_periodic_row_fails_with_each_clause(monkeypatch, run, birth, status):
     asked = []
 
+    case = (Body(), Gains(), trajectories.eight())        # the paper's body, gains and eight
+
     def verdicts(body, gains, ref, b, f):
+        assert (body, gains, ref) == case
         asked.append((float(np.degrees(b[0])), f))
         return pd.DataFrame([{**QP, **run}]), None
 
+    def extend(body, gains, ref, frame):
+        assert (body, gains, ref) == case
+        return frame
+
+    def birth_(fn, *args):       # Chapter 4's call: the torus's birth at its angle from its start cap
+        assert fn is report.torus_birth and args == case + (math.radians(report.NS_ANGLE_DEG), NS_START_CAP)
+        return _birth(**birth)
+
     assert trajectories.eight().period == 8.0
     got = _status(monkeypatch, "quasi", _angle_sweep=lambda cap: _sweep(), limit_verdicts=verdicts,
-                  extend_undecided=lambda body, gains, ref, frame: frame, cached=_cache(torus_birth=_birth(**birth)))
+                  extend_undecided=extend, cached=birth_)
     # exact: the angle 37 deg written in radians and read back
     assert got[0] == status and asked == [(pytest.approx(37.0), 6.0)]
 
@@ -357,9 +399,11 @@ def test_quasi_periodic_row_fails_with_each_clause(monkeypatch, run, birth, stat
 
 def test_rotation_equation_row_needs_the_papers_damping(monkeypatch):
     eq = derive_rotation_equation()
-    assert _status(monkeypatch, "eq32")[0] == "reproduced"
+    out = _outcome(monkeypatch, "eq32")[0]
+    assert out.status == "reproduced" and out.merit == 0.0     # exact: the residual's flag
     wrong = SimpleNamespace(params=eq.params, v_p=eq.v_p, rhs=eq.rhs + eq.params["c"] / eq.params["I"] * eq.v_p)
-    assert _status(monkeypatch, "eq32", derive_rotation_equation=lambda: wrong)[0] == "not reproducible"
+    out = _outcome(monkeypatch, "eq32", derive_rotation_equation=lambda: wrong)[0]
+    assert out.status == "not reproducible" and out.merit == 1.0     # exact: the residual's flag
 
 
 # the threshold is 1e-9 1/s; the two computations agree to about 1e-15
