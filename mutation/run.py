@@ -13,10 +13,10 @@ score and every surviving mutant, with its diff, to ``mutation/REPORT.md``. Each
 module is checked with the fast tests that cover it (:data:`TESTS`), not the whole
 suite. On 2 idle cores the six modules other than ``allocation`` take about 6 minutes,
 ``allocation`` about 11 and the verdict procedure about 1; the run is niced. ``weighting.circle``
-(887 mutants) and the ten modules of ``lib/paper`` (4864 mutants) are far slower: on the shared,
-loaded machine the circle's run was stopped at 759 mutants after 35 minutes (its mutants of the
-solver and the Jacobian run every test of the file), and the paper's took 39 minutes; run
-them on their own (``MODULES=weighting.circle make mutation``).
+(887 mutants) and the ten modules of ``lib/paper`` (about 4870 mutants) are slower: on 2 nearly
+idle cores the circle takes 17 minutes (its mutants of the solver and the Jacobian run every
+test of the file), the paper 16, then about 10 to write its survivors' diffs; run them on their
+own (``MODULES=weighting.circle make mutation``).
 
 The survivors are then triaged by hand in REPORT.md: killed by a new test
 (``tests/test_core_mutants.py``, ``tests/test_paper_mutants.py``) or listed as equivalent, with
