@@ -78,10 +78,9 @@ clean:
 # Mutation testing with mutmut, by hand (not in CI), niced: the core modules, the verdict
 # procedure, lib/weighting/circle.py and the ten modules of lib/paper (mutation/run.py, TESTS).
 # On 2 idle cores the core modules and the verdict procedure take about 20 min (the six core
-# modules other than allocation 6.2 min, allocation 11.4, the verdict procedure 1.0); on the
-# loaded machine (2026-11-25) lib/paper's 4864 mutants took 39 min and weighting.circle was
-# stopped at 759 of its 887 after 35 min: give those two their own run. Appends the score and
-# the surviving mutants to mutation/REPORT.md.
+# modules other than allocation 6.2 min, allocation 11.4, the verdict procedure 1.0);
+# weighting.circle takes 17 min and lib/paper 16 (then about 10 to write its survivors' diffs):
+# give those two their own run. Appends the score and the surviving mutants to mutation/REPORT.md.
 # MODULES="angles params" limits it to some of them.
 mutation: $(STAMP)
 	$(BIN)/python mutation/run.py $(MODULES)
