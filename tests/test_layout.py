@@ -178,7 +178,7 @@ def test_module_names_inside_a_folder_drop_the_folder_s_prefix():
 def test_a_face_package_re_exports_and_every_other_init_only_documents():
     # the public faces re-export the names readers import (issue 21's stable names among them);
     # every other folder's __init__ holds a docstring and, at most, imports of its own modules
-    faces = {"tracking", "limits", "rotation", "weighting", "percussion", "dynamics", "integrators", "paper"}
+    faces = {"tracking", "limits", "rotation", "weighting", "percussion", "dynamics", "integrators", "paper", "optimal"}
     for folder in (p for p in LIB.iterdir() if p.is_dir() and (p / "__init__.py").exists()):
         tree = ast.parse((folder / "__init__.py").read_text())
         defs = [n for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef))]

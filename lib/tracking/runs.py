@@ -373,7 +373,7 @@ def force_cap_sweep(body: Body, gains: Gains, ref: Reference, caps, *, n_periods
     All caps run together in the compiled integrator (:func:`lib.limits.runs.switched_runs`,
     which locates the cap's kinks), sampled ``samples_per_period`` times per period.
     Columns: ``cap``, ``pos_err_max`` (largest |(e_x, e_y)| over the last ``n_steady``
-    periods), ``ex_amp``, ``ey_amp`` (half peak-to-peak of each component) and
+    periods), ``pos_err_rms`` (its RMS over the same periods, each sample time once), ``ex_amp``, ``ey_amp`` (half peak-to-peak of each component) and
     ``sat_fraction`` (fraction of the samples at the cap). With an ``executor`` (any
     :class:`concurrent.futures.Executor`) the caps go to it in chunks of ``chunk_size``
     (:func:`lib.machinery.parallel.map_chunks`); each run is on its own: the same frame.
@@ -405,7 +405,7 @@ def force_cap_sweep(body: Body, gains: Gains, ref: Reference, caps, *, n_periods
     Returns
     -------
     pandas.DataFrame
-        One row per cap: cap (N), pos_err_max (m), ex_amp (m), ey_amp (m), sat_fraction.
+        One row per cap: cap (N), pos_err_max (m), pos_err_rms (m), ex_amp (m), ey_amp (m), sat_fraction.
     """
     caps = np.atleast_1d(checks.array("caps", caps, positive=True))
     if caps.ndim != 1 or caps.size == 0:
@@ -434,7 +434,8 @@ def _cap_chunk(caps, *, body, gains, ref, n_periods, n_steady, samples_per_perio
         st = runs.states[j, m]
         tau = computed_torque(body, gains, ref, runs.t[m], st[:, :3], st[:, 3:])
         F, _ = allocate(tau, st[:, 2], force_limit=float(cap))      # (25)-(26) with the cap
-        rows.append({"cap": float(cap), "pos_err_max": float(np.hypot(e[:, 0], e[:, 1]).max()),
+        d = np.hypot(e[:, 0], e[:, 1])
+        rows.append({"cap": float(cap), "pos_err_max": float(d.max()), "pos_err_rms": float(np.sqrt(np.mean(d[1:]**2))),
                      "ex_amp": float(np.ptp(e[:, 0]) / 2), "ey_amp": float(np.ptp(e[:, 1]) / 2),
                      "sat_fraction": float(np.mean(F >= cap * (1 - 1e-9)))})
     return pd.DataFrame(rows)

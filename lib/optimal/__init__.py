@@ -1,0 +1,20 @@
+"""Chapter 8: what the paper's limits allow, whatever the controller.
+
+* :mod:`.bound`: under a force cap alone the periodic motions of C form a convex set; the least
+  largest and RMS distance from the path, certified by a relaxation and its duality gap, beside
+  a motion that reaches it (:func:`cap_bound`; cvxpy with Clarabel); the force that exact
+  tracking of C needs (:func:`exact_peak_force`);
+* :mod:`.motion` (with :mod:`.collocation`): the best periodic motion found under an angle limit,
+  with or without the cap, by direct collocation of the full model (2)-(4) (CasADi and IPOPT),
+  verified by integrating its inputs (:func:`periodic_motion`, :func:`verify_motion`);
+* :mod:`.tracker`: a controller that reaches such a motion, the periodic LQR of its
+  linearisation with the limits enforced in the loop (:func:`track_motion`);
+* :mod:`.demand`: the force that exact tracking of C and of P needs over Fig. 5's grid;
+* :mod:`.loop`: any of the book's closed loops decided by the book's orbit procedure and measured;
+* :mod:`.study`: the chapter's computations, each one call shared with the report.
+"""
+
+from .bound import CapBound, cap_bound, exact_peak_force
+from .motion import PeriodicMotion, periodic_motion, verify_motion
+
+__all__ = ["CapBound", "cap_bound", "exact_peak_force", "PeriodicMotion", "periodic_motion", "verify_motion"]

@@ -1,0 +1,202 @@
+"""Any closed loop of the body under the paper's limits, decided and measured one way.
+
+Chapter 8 sets four controllers side by side under each limit setting: the paper's law, the
+weighted law of Chapter 6, the law for P of Chapter 7 and the controller of the optimal motion.
+Each is a periodically forced vector field ``rates(t, s)``, vectorised over rows of states. This
+module turns such a field into the book's period map (:class:`FlowMap`, a
+:class:`lib.dynamics.verdicts.PeriodMap`), decides its long-run regime with the book's one
+procedure for orbits (:func:`lib.dynamics.verdicts.find_orbits`: lag candidates, Newton on
+P^k(x) = x + 2 pi n e_phi with a difference Jacobian, Floquet multipliers, the reach test), and
+measures a run's steady errors and inputs (:func:`steady_measures`), extremes refined between
+samples (:func:`lib.dynamics.sampled.sampled_extremes`).
+
+A run on which no attracting orbit is located is ``undecided`` here with its reason: this module
+does not compute Lyapunov exponents, so it never says ``chaotic``; Chapter 4's verdicts do that
+for the paper's law.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from ..dynamics import verdicts as dv
+from ..dynamics.sampled import sampled_extremes
+from ..integrators.smooth import SimulationError
+from ..machinery import checks
+
+__all__ = ["FlowMap", "LoopVerdict", "loop_verdict", "run_periods", "steady_measures", "LOOP_OPTIONS"]
+
+Rates = Callable[[float, np.ndarray], np.ndarray]
+
+#: the procedure's settings here (state units: m, rad, m/s, rad/s): periods run before the orbit
+#: search, section states kept, longest period tried, and the tolerances of
+#: :func:`lib.dynamics.verdicts.find_orbits`; the integration's tolerances
+LOOP_OPTIONS = dict(transient=24, history=12, max_period=4, candidate_tol=1e-3, newton_tol=1e-8, reach_tol=1e-4,
+                    reach_floor=1e-8, fd_step=1e-6, newton_iter=12, rtol=1e-10, atol=1e-10)
+
+
+def _integrate(rates: Rates, x: np.ndarray, t0: float, t1: float, rtol: float, atol: float, dense: bool = False):
+    """solve_ivp (DOP853) of all rows of x (M, d) together from t0 to t1."""
+    M, d = x.shape
+
+    def f(t, y):
+        out = rates(t, y.reshape(M, d)).reshape(-1)
+        if not np.all(np.isfinite(out)):
+            raise SimulationError(f"the closed loop became non-finite at t = {t:.6g} s")
+        return out
+
+    sol = solve_ivp(f, (t0, t1), x.reshape(-1), method="DOP853", rtol=rtol, atol=atol, dense_output=dense)
+    if sol.status != 0:
+        raise SimulationError(f"the closed loop could not be integrated past t = {sol.t[-1]:.6g} s: {sol.message}")
+    return sol
+
+
+class FlowMap:
+    """The period map of a T-periodic field: ``advance(idx, x, k)`` integrates the rows x (M, d)
+    over k periods each (adaptive DOP853, all rows at once), the heading (column ``turn_axis``)
+    continuous. A :class:`lib.dynamics.verdicts.PeriodMap`; one field for every row (``idx`` unused)."""
+
+    def __init__(self, rates: Rates, period: float, *, turn_axis: int = 2, rtol: float = 1e-10,
+                 atol: float = 1e-10):
+        self.rates, self.period, self.turn_axis, self.rtol, self.atol = rates, float(period), turn_axis, rtol, atol
+
+    def advance(self, idx, x, k) -> np.ndarray:
+        x = np.array(x, dtype=float)
+        k = np.broadcast_to(np.asarray(k, dtype=int), (x.shape[0],))
+        for j in range(int(k.max(initial=0))):
+            go = k > j
+            sol = _integrate(self.rates, x[go], 0.0, self.period, self.rtol, self.atol)
+            x[go] = sol.y[:, -1].reshape(-1, x.shape[1])
+        return x
+
+
+@dataclass(frozen=True)
+class LoopVerdict:
+    """The regime of one closed loop from one start (:func:`loop_verdict`).
+
+    ``regime`` a word of :data:`lib.dynamics.verdicts.REGIMES` (``periodic``, ``slipping`` or
+    ``undecided``); ``period`` (periods of the forcing) and ``turns`` (of the heading per period
+    of the orbit); ``orbit`` (d,) the orbit's state at t = 0 (NaN without one); ``multipliers``
+    (d,) its Floquet multipliers; ``floquet`` the largest modulus; ``distance`` of the run's last
+    section state from the orbit (state units); ``reason`` why no orbit, where there is none;
+    ``section`` (L, d) the run's section states (t = j T)."""
+
+    regime: str
+    period: int
+    turns: int
+    orbit: np.ndarray
+    multipliers: np.ndarray
+    floquet: float
+    distance: float
+    reason: str
+    section: np.ndarray
+
+
+def run_periods(rates: Rates, period: float, s0, n_periods: int, *, samples: int = 0, rtol: float = 1e-10,
+                atol: float = 1e-10):
+    """Integrate one start s0 (d,) over ``n_periods`` periods: the section states (n + 1, d) at
+    t = j T and, with ``samples`` > 0, the states at ``samples`` equal steps a period over the
+    last period (t (samples,), states (samples, d)) from the integrator's dense output."""
+    x = np.asarray(s0, dtype=float)[None, :]
+    sec = [x[0].copy()]
+    t_s = s_s = None
+    for j in range(n_periods):
+        last = samples > 0 and j == n_periods - 1
+        sol = _integrate(rates, x, 0.0, period, rtol, atol, dense=last)
+        x = sol.y[:, -1].reshape(1, -1)
+        sec.append(x[0].copy())
+        if last:
+            t_s = np.arange(samples) * (period / samples)
+            s_s = sol.sol(t_s).T
+    return np.array(sec), t_s, s_s
+
+
+def loop_verdict(rates: Rates, period: float, s0, **options) -> LoopVerdict:
+    """The long-run regime of the closed loop s' = rates(t, s) (T = ``period`` s) from s0 (d,), by
+    the book's orbit procedure (:func:`lib.dynamics.verdicts.find_orbits`) on :class:`FlowMap`:
+    ``transient`` periods, then the last ``history`` section states searched for an orbit of
+    period k <= ``max_period`` (up to whole turns of the heading, column 2), Newton with a
+    difference Jacobian (step ``fd_step``), Floquet multipliers, the reach test. Options and
+    defaults: :data:`LOOP_OPTIONS`. A state that blows up gives ``undecided`` with the time.
+
+    Parameters
+    ----------
+    rates : callable
+        (t (s), s (M, d)) -> s' (M, d), T-periodic in t.
+    period : float
+        T (s), > 0.
+    s0 : array_like
+        The start (d,), heading in column 2.
+    **options
+        Keys of :data:`LOOP_OPTIONS`.
+
+    Returns
+    -------
+    LoopVerdict
+    """
+    o = checks.options(options, LOOP_OPTIONS, minima=dict(transient=1, history=3, max_period=1, newton_iter=1))
+    if not callable(rates):
+        raise TypeError(f"rates must be a callable (t, s) -> s', got {type(rates).__name__}")
+    period = checks.number("period", period, positive=True, unit="s")
+    s0 = checks.array("s0", s0, ndim=1)
+    d = s0.size
+    nan = np.full(d, np.nan)
+    try:
+        sec, _, _ = run_periods(rates, period, s0, o["transient"] + o["history"], rtol=o["rtol"], atol=o["atol"])
+    except SimulationError as err:
+        return LoopVerdict("undecided", 0, 0, nan, nan + 0j, np.nan, np.nan, f"diverged: {err}", np.empty((0, d)))
+    flow = FlowMap(rates, period, rtol=o["rtol"], atol=o["atol"])
+    hist = sec[-o["history"]:, None, :]
+    try:
+        orb = dv.find_orbits(lambda i, x, k: dv.difference_jacobian(flow, i, x, k, o["fd_step"]), flow,
+                             np.arange(1), hist, max_period=o["max_period"], candidate_tol=o["candidate_tol"],
+                             newton_tol=o["newton_tol"], reach_tol=o["reach_tol"], reach_floor=o["reach_floor"],
+                             newton_options=dict(max_iter=o["newton_iter"], stall_after=2))
+    except SimulationError as err:
+        return LoopVerdict("undecided", 0, 0, nan, nan + 0j, np.nan, np.nan, f"orbit search diverged: {err}", sec)
+    if not orb["found"][0]:
+        status = orb["status"][0] or "no candidate"
+        return LoopVerdict("undecided", 0, 0, nan, nan + 0j, float(orb["floquet"][0]), np.nan,
+                           f"no attracting orbit reached after {o['transient'] + o['history']} periods ({status})",
+                           sec)
+    k, n = int(orb["k"][0]), int(orb["n"][0])
+    regime = str(dv.orbit_regime(np.array([n]))[0])
+    return LoopVerdict(regime, k, n, orb["x"][0], orb["mult"][0], float(np.abs(orb["mult"][0]).max()),
+                       float(orb["distance"][0]), "", sec)
+
+
+def steady_measures(t, states, F, beta, path_z) -> dict:
+    """The steady errors and inputs over one period sampled at equal steps (the last sample one
+    step before the period closes): the largest and the RMS distance |C - C_d| (m), the peak
+    force F (N) and the peak |beta| (rad), and the range of the heading error p = phi - phi_d
+    (rad, continuous). Largest values are refined between samples by parabolas
+    (:func:`lib.dynamics.sampled.sampled_extremes`, cyclic; error O(h^3) for a smooth signal, and
+    the sampled value itself at a kink, such as a force held at its cap).
+
+    Parameters
+    ----------
+    t : array_like
+        Sample times (s), (n,), equal steps over one period.
+    states : array_like
+        (n, 6): x, y, phi and rates.
+    F, beta : array_like
+        Applied inputs (N, rad), (n,).
+    path_z : array_like
+        The path's z_d at t, (n, 3) (x_d, y_d, phi_d).
+
+    Returns
+    -------
+    dict
+        max_error, rms_error (m), F_peak (N), beta_peak (rad), p_range (rad).
+    """
+    states, path_z = np.asarray(states, dtype=float), np.asarray(path_z, dtype=float)
+    dist = np.hypot(states[:, 0] - path_z[:, 0], states[:, 1] - path_z[:, 1])
+    p = np.unwrap(states[:, 2] - path_z[:, 2])
+    top = lambda y: float(max(sampled_extremes(np.asarray(y, dtype=float)[None, :])[1][0], np.max(y)))  # noqa: E731
+    pmin, pmax = sampled_extremes(p[None, :], cyclic=False)
+    return dict(max_error=top(dist), rms_error=float(np.sqrt(np.mean(dist**2))), F_peak=top(F),
+                beta_peak=top(np.abs(beta)), p_range=float(pmax[0] - pmin[0]))

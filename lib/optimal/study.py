@@ -1,0 +1,151 @@
+"""Chapter 8's computations, each one call that the chapter and the report share (through
+:func:`lib.machinery.cache.cached`, with the same arguments): the bound under a force cap over
+caps and meshes (:func:`cap_sweep`, :func:`cap_convergence`), the best periodic motions under
+the angle limits by continuation (:func:`limit_motions`) and their mesh study
+(:func:`motion_convergence`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from ..machinery import checks
+from ..params import Body
+from .bound import cap_bound, exact_peak_force
+from .motion import PeriodicMotion, periodic_motion, verify_motion
+
+__all__ = ["PAPER_CAP", "CHAPTER_ANGLES_DEG", "SETTINGS", "setting_label", "cap_sweep", "cap_convergence",
+           "limit_motions", "motion_convergence"]
+
+#: the paper's force cap (N), Fig. 4
+PAPER_CAP = 4.0
+#: Chapter 4's chosen angle limits (deg), in the order of the continuation (the largest first)
+CHAPTER_ANGLES_DEG = (90, 60, 45, 30)
+#: the limit settings of Chapter 8's comparison: (angle limit (deg) or None, cap (N) or None)
+SETTINGS = ((None, PAPER_CAP),) + tuple((a, None) for a in CHAPTER_ANGLES_DEG[::-1]) \
+    + tuple((a, PAPER_CAP) for a in CHAPTER_ANGLES_DEG[::-1])
+
+
+def setting_label(angle_deg, cap) -> str:
+    """'4 N', '30 deg', '30 deg + 4 N': the words of a limit setting."""
+    parts = ([] if angle_deg is None else [f"{angle_deg:g} deg"]) + ([] if cap is None else [f"{cap:g} N"])
+    return " + ".join(parts) or "none"
+
+
+def _check(body, R, Theta, kind):
+    checks.instance("body", body, Body)
+    checks.one_of("kind", kind, ("eight", "circle"))
+    return checks.number("R", R, positive=True, unit="m"), checks.number("Theta", Theta, positive=True, unit="rad/s")
+
+
+def cap_sweep(body: Body, R: float, Theta: float, caps, *, kind: str = "eight", nodes: int = 256) -> pd.DataFrame:
+    """:func:`lib.optimal.bound.cap_bound` at each cap (N): one row per cap with the certified lower
+    bounds and the achieved values of the largest and the RMS distance (m), and the gap (m).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    R, Theta : float
+        The path's size (m) and rate (rad/s), > 0.
+    caps : array_like
+        Force caps F_max (N), > 0, 1-D.
+    kind : str
+        ``"eight"`` or ``"circle"``.
+    nodes : int
+        Nodes per period.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns cap, max_error, max_error_achieved, rms_error, rms_error_achieved, gap, demand
+        (the exact-tracking peak force, N).
+    """
+    R, Theta = _check(body, R, Theta, kind)
+    caps = np.atleast_1d(checks.array("caps", caps, positive=True, ndim=1, nonempty=True))
+    checks.integer("nodes", nodes, minimum=16)
+    demand = float(exact_peak_force(body, R, Theta, kind=kind))
+    rows = []
+    for cap in caps:
+        b = cap_bound(body, R, Theta, float(cap), kind=kind, nodes=nodes)
+        rows.append(dict(cap=float(cap), max_error=b.max_error, max_error_achieved=b.max_error_achieved,
+                         rms_error=b.rms_error, rms_error_achieved=b.rms_error_achieved, gap=b.gap, demand=demand))
+    return pd.DataFrame(rows)
+
+
+def cap_convergence(body: Body, R: float, Theta: float, F_max: float, nodes=(64, 128, 256, 512), *,
+                    kind: str = "eight") -> pd.DataFrame:
+    """The bound against the mesh: :func:`lib.optimal.bound.cap_bound` at each number of nodes,
+    with the bracket (achieved - lower bound, m) of each objective.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns nodes, max_error, max_error_achieved, max_bracket, rms_error, rms_error_achieved,
+        rms_bracket, gap (all m).
+    """
+    R, Theta = _check(body, R, Theta, kind)
+    F_max = checks.number("F_max", F_max, positive=True, unit="N")
+    nodes = [checks.integer("nodes", n, minimum=16) for n in np.atleast_1d(nodes)]
+    rows = []
+    for n in nodes:
+        b = cap_bound(body, R, Theta, F_max, kind=kind, nodes=n)
+        rows.append(dict(nodes=n, max_error=b.max_error, max_error_achieved=b.max_error_achieved,
+                         max_bracket=b.max_error_achieved - b.max_error, rms_error=b.rms_error,
+                         rms_error_achieved=b.rms_error_achieved, rms_bracket=b.rms_error_achieved - b.rms_error,
+                         gap=b.gap))
+    return pd.DataFrame(rows)
+
+
+def limit_motions(body: Body, R: float, Theta: float, *, kind: str = "eight", angles_deg=CHAPTER_ANGLES_DEG,
+                  caps=(None, PAPER_CAP), nodes: int = 80) -> dict:
+    """The best periodic motions found (:func:`lib.optimal.motion.periodic_motion`) at every
+    setting: for each cap (N, or None) the angle limits in the given order, each started from its
+    own starts and from the motion of the limit before (continuation: the largest limit first, so
+    that each smaller one starts from a motion just outside its set); with a cap, also the cap
+    alone (key (None, cap)).
+
+    Returns
+    -------
+    dict
+        (angle limit in deg or None, cap in N or None) -> PeriodicMotion.
+    """
+    R, Theta = _check(body, R, Theta, kind)
+    angles = [checks.number("angles_deg", a, positive=True, maximum=180.0) for a in angles_deg]
+    caps = [None if c is None else checks.number("caps", c, positive=True, unit="N") for c in caps]
+    checks.integer("nodes", nodes, minimum=8)
+    out: dict = {}
+    for cap in caps:
+        if cap is not None:
+            out[(None, cap)] = periodic_motion(body, R, Theta, kind=kind, F_max=cap, nodes=nodes)
+        guess = None
+        for a in angles:
+            m = periodic_motion(body, R, Theta, kind=kind, F_max=cap, beta_max=math.radians(a), nodes=nodes,
+                                guess=guess)
+            out[(int(a) if float(a).is_integer() else a, cap)] = m
+            guess = m
+    return out
+
+
+def motion_convergence(body: Body, R: float, Theta: float, beta_max: float, F_max: float | None,
+                       nodes=(40, 80, 160), *, kind: str = "eight") -> pd.DataFrame:
+    """The best motion under (beta_max (rad), F_max (N or None)) against the mesh: its RMS and
+    largest distance (m), its peak force (N), and the return error of its inputs integrated by
+    the book's integrator over one period (:func:`lib.optimal.motion.verify_motion`, the
+    max-norm of the state's mismatch: m, rad, m/s, rad/s).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns nodes, rms_error, max_error, F_peak, return_error.
+    """
+    R, Theta = _check(body, R, Theta, kind)
+    rows = []
+    for n in [checks.integer("nodes", n, minimum=8) for n in np.atleast_1d(nodes)]:
+        m: PeriodicMotion = periodic_motion(body, R, Theta, kind=kind, F_max=F_max, beta_max=beta_max, nodes=n)
+        rows.append(dict(nodes=n, rms_error=m.rms_error, max_error=m.max_error, F_peak=float(m.F.max()),
+                         return_error=verify_motion(body, m)))
+    return pd.DataFrame(rows)

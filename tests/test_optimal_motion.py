@@ -1,0 +1,201 @@
+"""The best periodic motions under the paper's limits (lib.optimal.motion, lib.optimal.collocation)."""
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from lib import model
+from lib.optimal import collocation as col
+from lib.optimal import motion as mo
+from lib.params import Body
+from lib.trajectories import make
+
+BODY = Body()
+R, THETA = 2.0, math.pi / 4
+DEG = math.pi / 180
+
+
+@pytest.fixture(scope="module")
+def capped30():
+    """The eight under beta_max = 30 deg and F_max = 4 N at the default mesh."""
+    return mo.periodic_motion(BODY, R, THETA, F_max=4.0, beta_max=30 * DEG, starts=("paper", "force"))
+
+
+def test_casadi_right_hand_side_equals_config_accel_at_random_states():
+    rng = np.random.default_rng(7)
+    body = Body(m=1.3, I=0.07, a=0.55, c=0.9, c_phi=0.2)   # not the defaults: every parameter must enter
+    f = col.accel_function(body)
+    z = rng.normal(size=(200, 3)) * [2.0, 2.0, 6.0]
+    dz = rng.normal(size=(200, 3)) * 3.0
+    F, beta = rng.uniform(0.0, 10.0, 200), rng.uniform(-4.0, 4.0, 200)
+    want = model.config_accel(body, z, dz, F, beta)
+    got = np.array(f.map(200)(z.T, dz.T, np.stack([F, beta])).full()).T
+    # the same few flops in another order: rounding only, 1e-12 of the largest term
+    scale = np.abs(want).max(axis=1, keepdims=True) + 1.0
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * scale.max())
+
+
+@pytest.mark.parametrize("degree", [1, 2, 3, 4, 5])
+def test_tableau_is_exact_for_polynomials_of_its_order(degree):
+    tab = col.tableau(degree)
+    rng = np.random.default_rng(degree)
+    # a polynomial of degree d is its own interpolant: derivative at the points and end value exact
+    p = np.poly1d(rng.normal(size=degree + 1))
+    vals = p(tab.tau)
+    np.testing.assert_allclose(vals @ tab.C, np.polyder(p)(tab.tau[1:]), atol=1e-11 * np.abs(p.coeffs).sum() * 10)
+    assert vals @ tab.D == pytest.approx(p(1.0), abs=1e-12 * np.abs(p.coeffs).sum() * 10)
+    # Gauss-Legendre quadrature: exact to degree 2 d - 1 (not to 2 d)
+    q = np.poly1d(rng.normal(size=2 * degree))
+    assert tab.B @ q(tab.tau[1:]) == pytest.approx(np.polyint(q)(1.0), abs=1e-13 * np.abs(q.coeffs).sum() * 10)
+    x2d = np.poly1d([1.0] + [0.0] * (2 * degree))
+    assert abs(tab.B @ x2d(tab.tau[1:]) - 1.0 / (2 * degree + 1)) > 1e-6
+
+
+def test_without_limits_the_optimum_tracks_the_eight_in_the_mesh_limit():
+    """With free beta and no cap the paper's orbit keeps C exactly on the path with smooth inputs;
+    the piecewise-constant inputs leave an error that vanishes with the mesh, at least like h^2."""
+    m40 = mo.periodic_motion(BODY, R, THETA, nodes=40, starts=("paper",))
+    m80 = mo.periodic_motion(BODY, R, THETA, nodes=80, starts=("paper",))
+    t = np.linspace(0, m80.period, 2001)
+    w, dw = mo._force(BODY, "eight", R, THETA, t)
+    h = m80.period / 80
+    # a piecewise-constant force misses the smooth w by up to h |w'| / 2; over an interval that moves C
+    # by at most (h^2 / 2) (h |w'| / 2) / m; bound a period's sum of such kicks by h^2 |w'| T / m
+    bound = h**2 * np.linalg.norm(dw, axis=1).max() * m80.period / BODY.m
+    assert m80.rms_error <= m80.max_error < bound / 10
+    assert m40.rms_error / m80.rms_error >= 4.0
+    assert m40.max_error / m80.max_error >= 4.0
+
+
+def test_without_limits_the_circle_is_tracked_to_the_collocation_error():
+    """On the circle the force has a constant size and angle to the body: constant inputs track
+    exactly, and what is left is the collocation's own error at its points (stage order d + 1 = 4,
+    so a factor 16 per halving of h; ask 10)."""
+    m16, m32 = (mo.periodic_motion(BODY, R, THETA, kind="circle", nodes=n, starts=("force",)) for n in (16, 32))
+    assert m16.turns == 1
+    assert m16.rms_error / m32.rms_error >= 10 and m16.max_error / m32.max_error >= 10
+    assert m32.max_error < 1e-5 * R
+    # the heading turns once a period, and the integrated motion closes with that turn
+    assert m32.state(m32.period)[0][2] - m32.state(0.0)[0][2] == pytest.approx(2 * math.pi, abs=1e-12)
+    assert mo.verify_motion(BODY, m32) < 1e-8
+
+
+def test_limited_motion_satisfies_its_limits(capped30):
+    m = capped30
+    assert np.all(np.abs(m.beta) <= 30 * DEG * (1 + 1e-8))
+    assert np.all(m.F >= -1e-8) and np.all(m.F <= 4.0 * (1 + 1e-8))
+    assert np.any(np.abs(m.beta) > 30 * DEG * (1 - 1e-6))         # the limit binds
+    free = mo.periodic_motion(BODY, R, THETA, beta_max=30 * DEG, starts=("force",))
+    assert np.all(np.abs(free.beta) <= 30 * DEG * (1 + 1e-8)) and np.all(free.F >= -1e-8)
+    assert mo.verify_motion(BODY, free) < 1e-6
+
+
+def test_return_error_shrinks_with_the_mesh_at_the_collocation_order():
+    """Legendre collocation of degree 3 is of order 6 at the nodes: doubling the mesh divides the
+    return error by 64 asymptotically; each mesh has its own optimum (other inputs), so ask 16.
+    (With F capped: without a cap the angle-limited optimum asks for ever larger force pulses as
+    the mesh refines, the solution's derivatives grow with them, and the rate is lost.)"""
+    errs = [mo.verify_motion(BODY, mo.periodic_motion(BODY, R, THETA, F_max=4.0, beta_max=30 * DEG, nodes=n,
+                                                      starts=("force",)), rtol=1e-12, atol=1e-12)
+            for n in (40, 80, 160)]
+    assert errs[0] / errs[1] >= 16 and errs[1] / errs[2] >= 16
+    assert errs[2] < 1e-8
+
+
+def test_verify_motion_catches_inputs_that_do_not_produce_the_motion(capped30):
+    bad = replace(capped30, F=capped30.F * (1 + 1e-3))
+    assert mo.verify_motion(BODY, bad) > 1e3 * mo.verify_motion(BODY, capped30)
+
+
+def test_state_and_inputs_interpolate_the_nodes_and_extend_periodically(capped30):
+    m = capped30
+    z, dz = m.state(m.t)
+    # t_k N / T is k up to rounding, and the basis moves the value by its slope times that: 1e-12
+    np.testing.assert_allclose(z, m.z, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(dz, m.dz, rtol=0, atol=1e-12)
+    F, beta = m.inputs(m.t + 0.5 * m.period / m.nodes)
+    np.testing.assert_array_equal(F, m.F)
+    np.testing.assert_array_equal(beta, m.beta)
+    t = np.linspace(0.0, m.period, 77, endpoint=False)
+    for a, b in zip(m.state(t + 2 * m.period), m.state(t)):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-12 * (1 + np.abs(b).max()))
+    np.testing.assert_array_equal(m.inputs(t - m.period)[0], m.inputs(t)[0])
+    # each interval's polynomial ends where the next begins (the continuity equations, to IPOPT's tolerance)
+    ends = np.einsum("r,kri->ki", col.tableau(m.degree).D, m.collocation)
+    np.testing.assert_allclose(ends[:-1], m.collocation[1:, 0], rtol=0, atol=1e-9)
+
+
+def test_errors_are_the_distances_from_the_path_on_a_fine_grid(capped30):
+    m = capped30
+    t = np.linspace(0.0, m.period, 200 * m.nodes, endpoint=False)
+    d = np.linalg.norm(m.state(t)[0][:, :2] - make("eight", R, THETA).z(t)[:, :2], axis=1)
+    # the refined maximum is at least every sample's, and the samples come within their spacing's reach
+    assert d.max() <= m.max_error + 1e-12
+    assert m.max_error - d.max() < 1e-6 * m.max_error
+    # the collocation quadrature against the fine grid's mean: both converge to the integral
+    assert m.rms_error == pytest.approx(math.sqrt((d**2).mean()), rel=1e-4)
+
+
+def test_a_smaller_angle_limit_cannot_do_better_and_warm_starts_match_cold_ones():
+    """The feasible sets are nested, so the optimum can only grow as beta_max shrinks; the
+    continuation 90 -> 60 -> 45 -> 30 deg (each warm-started by the last) must show it, and the
+    30 deg optimum from the 45 deg one alone must be no worse than from the cold starts."""
+    prev, chain = None, []
+    for deg in (90, 60, 45, 30):
+        prev = mo.periodic_motion(BODY, R, THETA, F_max=4.0, beta_max=deg * DEG, guess=prev,
+                                  starts=("force",))
+        chain.append(prev)
+    rms = [m.rms_error for m in chain]
+    assert all(b >= a * (1 - 1e-6) for a, b in zip(rms, rms[1:])), rms
+    assert rms[-1] > 1.2 * rms[0]                       # and the limit costs something
+    assert [s[0] for s in chain[-1].starts] == ["force", "guess[0]"]
+    warm = mo.periodic_motion(BODY, R, THETA, F_max=4.0, beta_max=30 * DEG, guess=chain[2], starts=())
+    cold = mo.periodic_motion(BODY, R, THETA, F_max=4.0, beta_max=30 * DEG)
+    assert [s[0] for s in warm.starts] == ["guess[0]"]
+    assert [s[0] for s in cold.starts] == ["paper", "force", "shifted+", "shifted-"]
+    assert warm.rms_error <= cold.rms_error * (1 + 1e-6)
+
+
+def test_no_accepted_start_raises(monkeypatch):
+    monkeypatch.setattr(mo, "ACCEPTED", ())
+    with pytest.raises(RuntimeError, match="accepted no start.*force: Solve_Succeeded"):
+        mo.periodic_motion(BODY, R, THETA, kind="circle", nodes=8, starts=("force",))
+
+
+@pytest.mark.parametrize("kw, exc, name", [
+    (dict(body=None), TypeError, "body"), (dict(R=-1.0), ValueError, "R"), (dict(R="2"), TypeError, "R"),
+    (dict(Theta=0.0), ValueError, "Theta"), (dict(Theta=math.nan), ValueError, "Theta"),
+    (dict(kind="square"), ValueError, "kind"), (dict(F_max=0.0), ValueError, "F_max"),
+    (dict(F_max=True), TypeError, "F_max"), (dict(beta_max=0.0), ValueError, "beta_max"),
+    (dict(beta_max=3.2), ValueError, "beta_max"), (dict(nodes=7), ValueError, "nodes"),
+    (dict(nodes=80.0), TypeError, "nodes"), (dict(nodes=mo.MAX_NODES + 1), ValueError, "nodes"),
+    (dict(degree=0), ValueError, "degree"), (dict(degree=6), ValueError, "degree"),
+    (dict(guess="motion"), TypeError, "guess"), (dict(guess=[None]), TypeError, r"guess\[0\]"),
+    (dict(guess="R"), ValueError, "guess"), (dict(guess="kind"), ValueError, "guess"),
+    (dict(starts="paper"), TypeError, "starts"), (dict(starts=("bogus",)), ValueError, "starts"),
+    (dict(starts=()), ValueError, "starts"),
+])
+def test_bad_arguments_raise_naming_them_before_any_solve(monkeypatch, capped30, kw, exc, name):
+    def forbidden(*a, **k):
+        raise AssertionError("work began before the arguments were checked")
+    monkeypatch.setattr(mo, "transcription", forbidden)
+    monkeypatch.setattr(mo, "paper_steady", forbidden)
+    if kw.get("guess") == "R":
+        kw = dict(guess=replace(capped30, R=3.0))
+    elif kw.get("guess") == "kind":
+        kw = dict(guess=[capped30, replace(capped30, kind="circle")])
+    args = dict(body=BODY, R=R, Theta=THETA) | kw
+    with pytest.raises(exc, match=f"^{name}"):
+        mo.periodic_motion(args.pop("body"), args.pop("R"), args.pop("Theta"), **args)
+
+
+@pytest.mark.parametrize("kw, exc, name", [
+    (dict(body="body"), TypeError, "body"), (dict(motion=None), TypeError, "motion"),
+    (dict(rtol=0.0), ValueError, "rtol"), (dict(atol=-1.0), ValueError, "atol"),
+])
+def test_verify_motion_bad_arguments_raise_naming_them(capped30, kw, exc, name):
+    args = dict(body=BODY, motion=capped30) | kw
+    with pytest.raises(exc, match=f"^{name}"):
+        mo.verify_motion(args.pop("body"), args.pop("motion"), **args)
