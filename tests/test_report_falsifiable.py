@@ -250,7 +250,69 @@ def test_percussion_map_row_fails_with_one_point_not_held(monkeypatch, regime, l
     assert _status(monkeypatch, "percussion-map", cached=_cache(percussion_fig5_map=fr)) == status
 
 
+# ------------------------------------------------------------------ Chapter 8's rows
+
+_SETTINGS = [(None, 4.0), (30, None), (30, 4.0)]
+
+
+def _ch8_study(*, bound=0.1, achieved=0.1002, gap=1e-9, law_max=None, paper_rms=None, motion_rms=None,
+           regimes=None, optimal_rms=None):
+    """Chapter 8's study with every clause met, or broken where an argument says so."""
+    rows = []
+    law_max = law_max or {}
+    for i, (a, c) in enumerate(_SETTINGS):
+        base = dict(setting=f"s{i}", angle_deg=np.nan if a is None else float(a), cap=np.nan if c is None else c)
+        rows.append(dict(base, law="paper", regime="periodic", max_error=law_max.get(i, 0.4),
+                         rms_error=(paper_rms or {}).get(i, 0.3), floquet=np.nan, paper_start_reached=np.nan))
+        rows.append(dict(base, law="optimal", regime=(regimes or {}).get(i, "periodic"), max_error=0.15,
+                         rms_error=(optimal_rms or {}).get(i, 0.05), floquet=0.1, paper_start_reached=True))
+    motions = {k: SimpleNamespace(rms_error=(motion_rms or {}).get(i, 0.05)) for i, k in enumerate(_SETTINGS)}
+    b = SimpleNamespace(max_error=bound, max_error_achieved=achieved, gap=gap)
+    return dict(table=pd.DataFrame(rows), motions=motions, bound=b)
+
+
+def _cached_study(st):
+    def fake(fn, *args):
+        assert fn is ext.limits_study and _same(args, (ext.Body(), ext.Gains(), ext.R0, ext.THETA0)), args
+        return st
+    return fake
+
+
+@pytest.mark.parametrize("kw, status", [
+    ({}, "extended"),
+    ({"bound": 0.0, "achieved": 0.0}, "not reproducible"),            # no bound
+    ({"achieved": 0.1 * 1.02}, "not reproducible"),                   # bracket 2 % wide
+    ({"gap": 1e-5}, "not reproducible"),                              # solver not converged
+    ({"law_max": {0: 0.09}}, "not reproducible"),                     # a law below the bound
+    ({"law_max": {2: 0.09}}, "not reproducible"),                     # ... at another capped setting
+    ({"law_max": {1: 0.09}}, "extended"),                             # no cap there: not compared
+])
+def test_cap_bound_row_fails_with_each_clause(monkeypatch, kw, status):
+    assert _status(monkeypatch, "cap-bound", cached=_cached_study(_ch8_study(**kw))) == status
+
+
+@pytest.mark.parametrize("kw, ret, status", [
+    ({}, 1e-9, "extended"),
+    ({}, 1e-5, "not reproducible"),                                   # a motion not reproduced by integration
+    ({"motion_rms": {2: 0.31}}, 1e-9, "not reproducible"),            # no better than the paper's law
+    ({"motion_rms": {0: 0.31}}, 1e-9, "not reproducible"),            # ... at the cap alone
+    ({"motion_rms": {1: 0.31}}, 1e-9, "extended"),                    # uncapped: not claimed
+])
+def test_angle_optimum_row_fails_with_each_clause(monkeypatch, kw, ret, status):
+    assert _status(monkeypatch, "angle-optimum", cached=_cached_study(_ch8_study(**kw)),
+                   verify_motion=lambda body, m: ret) == status
+
+
+@pytest.mark.parametrize("kw, status", [
+    ({}, "extended"),
+    ({"regimes": {1: "undecided"}}, "not reproducible"),              # one setting not periodic
+    ({"optimal_rms": {2: 0.06}}, "not reproducible"),                 # the loop 1 cm off its plan
+])
+def test_optimal_tracker_row_fails_with_each_clause(monkeypatch, kw, status):
+    assert _status(monkeypatch, "optimal-tracker", cached=_cached_study(_ch8_study(**kw))) == status
+
+
 def test_every_extension_row_has_a_falsifying_test():
     tested = {"limit-lyapunov", "limit-mirror", "wrong-model", "slow-eights", "window", "weight-limit",
-              "percussion-circle", "percussion-map"}
+              "percussion-circle", "percussion-map", "cap-bound", "angle-optimum", "optimal-tracker"}
     assert set(ITEMS) == tested

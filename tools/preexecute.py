@@ -43,7 +43,7 @@ KERNEL_ENV = {"OPENBLAS_NUM_THREADS": "1"}
 #: a page's CPU time (s), measured, to start the longest first (unknown pages first of all)
 COST = {"chapters/04_limits": 167, "chapters/05_stability": 96, "chapters/03_tracking": 41,
         "chapters/06_allocation": 31, "chapters/07_percussion": 8, "chapters/02_controllability": 10,
-        "chapters/01_model": 3, "methods": 1}
+        "chapters/01_model": 3, "methods": 1, "chapters/08_optimal": 140}
 
 
 def _config(root: Path) -> dict:

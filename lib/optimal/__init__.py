@@ -8,13 +8,18 @@
   with or without the cap, by direct collocation of the full model (2)-(4) (CasADi and IPOPT),
   verified by integrating its inputs (:func:`periodic_motion`, :func:`verify_motion`);
 * :mod:`.tracker`: a controller that reaches such a motion, the periodic LQR of its
-  linearisation with the limits enforced in the loop (:func:`track_motion`);
+  linearisation with the limits enforced in the loop (:func:`track_motion`), decided by the
+  book's procedure in :mod:`.verdict` (:func:`motion_verdict`, and its basin);
 * :mod:`.demand`: the force that exact tracking of C and of P needs over Fig. 5's grid;
 * :mod:`.loop`: any of the book's closed loops decided by the book's orbit procedure and measured;
-* :mod:`.study`: the chapter's computations, each one call shared with the report.
+* :mod:`.study` and :mod:`.compare`: the chapter's computations, each one call shared with the
+  report, and every law of the book under each limit setting beside the best motion and the bound.
 """
 
 from .bound import CapBound, cap_bound, exact_peak_force
 from .motion import PeriodicMotion, periodic_motion, verify_motion
+from .tracker import PeriodicLQR, periodic_lqr, track_motion
+from .verdict import MotionVerdict, motion_verdict
 
-__all__ = ["CapBound", "cap_bound", "exact_peak_force", "PeriodicMotion", "periodic_motion", "verify_motion"]
+__all__ = ["CapBound", "cap_bound", "exact_peak_force", "PeriodicMotion", "periodic_motion", "verify_motion",
+           "PeriodicLQR", "periodic_lqr", "track_motion", "MotionVerdict", "motion_verdict"]

@@ -25,18 +25,39 @@ from scipy.integrate import solve_ivp
 
 from ..dynamics import verdicts as dv
 from ..dynamics.sampled import sampled_extremes
-from ..integrators.smooth import SimulationError
+from ..integrators.batch import RK4, integrate
+from ..integrators.smooth import Integration, SimulationError
 from ..machinery import checks
 
 __all__ = ["FlowMap", "LoopVerdict", "loop_verdict", "run_periods", "steady_measures", "LOOP_OPTIONS"]
 
 Rates = Callable[[float, np.ndarray], np.ndarray]
 
+#: a state beyond this magnitude (m, rad, m/s, rad/s) has blown up: the bound of
+#: :class:`lib.integrators.smooth.Integration`
+BLOWUP = Integration.blowup
+
 #: the procedure's settings here (state units: m, rad, m/s, rad/s): periods run before the orbit
 #: search, section states kept, longest period tried, and the tolerances of
 #: :func:`lib.dynamics.verdicts.find_orbits`; the integration's tolerances
+#: (``steps`` = 0: adaptive DOP853 at rtol, atol; ``steps`` > 0: classical RK4 with that many
+#: fixed steps a period, the batch integrator of Chapter 6, whose cost does not grow where a
+#: clipped angle chatters across its switching surface)
 LOOP_OPTIONS = dict(transient=24, history=12, max_period=4, candidate_tol=1e-3, newton_tol=1e-8, reach_tol=1e-4,
-                    reach_floor=1e-8, fd_step=1e-6, newton_iter=12, rtol=1e-10, atol=1e-10)
+                    reach_floor=1e-8, fd_step=1e-6, newton_iter=12, rtol=1e-10, atol=1e-10, steps=0)
+_INTEGER_OPTIONS = dict(transient=1, history=3, max_period=1, newton_iter=1, steps=0)
+
+
+def _fixed(rates: Rates, x: np.ndarray, t0: float, t1: float, steps: int):
+    """Classical RK4 with ``steps`` fixed steps from t0 to t1, every step recorded: (t, states (n, M, d))."""
+    def f(t, y):
+        if np.max(np.abs(y)) > BLOWUP:
+            raise FloatingPointError(f"a state beyond {BLOWUP:g} at t = {t:.6g} s")
+        return rates(t, y)
+    try:
+        return integrate(f, x, t0, t1, (t1 - t0) / steps, RK4)
+    except FloatingPointError as err:
+        raise SimulationError(f"the closed loop blew up: {err}") from None
 
 
 def _integrate(rates: Rates, x: np.ndarray, t0: float, t1: float, rtol: float, atol: float, dense: bool = False):
@@ -45,8 +66,9 @@ def _integrate(rates: Rates, x: np.ndarray, t0: float, t1: float, rtol: float, a
 
     def f(t, y):
         out = rates(t, y.reshape(M, d)).reshape(-1)
-        if not np.all(np.isfinite(out)):
-            raise SimulationError(f"the closed loop became non-finite at t = {t:.6g} s")
+        if not np.all(np.isfinite(out)) or np.max(np.abs(y)) > BLOWUP:
+            raise SimulationError(f"the closed loop blew up at t = {t:.6g} s (a state beyond {BLOWUP:g} "
+                                  "or a rate not finite)")
         return out
 
     sol = solve_ivp(f, (t0, t1), x.reshape(-1), method="DOP853", rtol=rtol, atol=atol, dense_output=dense)
@@ -61,16 +83,30 @@ class FlowMap:
     continuous. A :class:`lib.dynamics.verdicts.PeriodMap`; one field for every row (``idx`` unused)."""
 
     def __init__(self, rates: Rates, period: float, *, turn_axis: int = 2, rtol: float = 1e-10,
-                 atol: float = 1e-10):
-        self.rates, self.period, self.turn_axis, self.rtol, self.atol = rates, float(period), turn_axis, rtol, atol
+                 atol: float = 1e-10, steps: int = 0):
+        self.rates, self.period, self.turn_axis = rates, float(period), turn_axis
+        self.rtol, self.atol, self.steps = rtol, atol, steps
+
+    def one(self, x: np.ndarray, samples: int = 0):
+        """One period from the rows x (M, d) at t = 0: the end (M, d) and, with ``samples`` > 0
+        (adaptive) or always (fixed steps), the times and states at equal steps over the period
+        (the end left out)."""
+        if self.steps:
+            t, y = _fixed(self.rates, x, 0.0, self.period, self.steps)
+            return y[-1], t[:-1], y[:-1]
+        sol = _integrate(self.rates, x, 0.0, self.period, self.rtol, self.atol, dense=samples > 0)
+        end = sol.y[:, -1].reshape(x.shape)
+        if not samples:
+            return end, None, None
+        t = np.arange(samples) * (self.period / samples)
+        return end, t, sol.sol(t).T.reshape(samples, *x.shape)
 
     def advance(self, idx, x, k) -> np.ndarray:
         x = np.array(x, dtype=float)
         k = np.broadcast_to(np.asarray(k, dtype=int), (x.shape[0],))
         for j in range(int(k.max(initial=0))):
             go = k > j
-            sol = _integrate(self.rates, x[go], 0.0, self.period, self.rtol, self.atol)
-            x[go] = sol.y[:, -1].reshape(-1, x.shape[1])
+            x[go] = self.one(x[go])[0]
         return x
 
 
@@ -79,8 +115,8 @@ class LoopVerdict:
     """The regime of one closed loop from one start (:func:`loop_verdict`).
 
     ``regime`` a word of :data:`lib.dynamics.verdicts.REGIMES` (``periodic``, ``slipping`` or
-    ``undecided``); ``period`` (periods of the forcing) and ``turns`` (of the heading per period
-    of the orbit); ``orbit`` (d,) the orbit's state at t = 0 (NaN without one); ``multipliers``
+    ``undecided``); ``period`` (periods of the forcing) and ``turns`` (whole turns the heading
+    gains on the path's per ``period`` periods of the orbit); ``orbit`` (d,) the orbit's state at t = 0 (NaN without one); ``multipliers``
     (d,) its Floquet multipliers; ``floquet`` the largest modulus; ``distance`` of the run's last
     section state from the orbit (state units); ``reason`` why no orbit, where there is none;
     ``section`` (L, d) the run's section states (t = j T)."""
@@ -96,32 +132,58 @@ class LoopVerdict:
     section: np.ndarray
 
 
-def run_periods(rates: Rates, period: float, s0, n_periods: int, *, samples: int = 0, rtol: float = 1e-10,
-                atol: float = 1e-10):
-    """Integrate one start s0 (d,) over ``n_periods`` periods: the section states (n + 1, d) at
-    t = j T and, with ``samples`` > 0, the states at ``samples`` equal steps a period over the
-    last period (t (samples,), states (samples, d)) from the integrator's dense output."""
+def run_periods(flow: FlowMap, s0, n_periods: int, *, samples: int = 0, record: int = 1):
+    """Run one start s0 (d,) of ``flow`` over ``n_periods`` periods: the section states (n + 1, d)
+    at t = j T and the states at equal steps over the last ``record`` periods (t from the first
+    of them, (n_rec,); states (n_rec, d)): ``samples`` a period on the adaptive integrator's dense
+    output, or the fixed steps themselves.
+
+    Parameters
+    ----------
+    flow : FlowMap
+        The closed loop's period map.
+    s0 : array_like
+        The start (d,) at t = 0.
+    n_periods : int
+        Periods run.
+    samples : int
+        Samples a period with the adaptive integrator (0: none).
+    record : int
+        The last periods recorded.
+
+    Returns
+    -------
+    section : numpy.ndarray
+        (n_periods + 1, d) the states at t = j T.
+    t, states : numpy.ndarray or None
+        The recorded times (s) and states (n_rec, d), None when nothing is recorded.
+    """
     x = np.asarray(s0, dtype=float)[None, :]
-    sec = [x[0].copy()]
-    t_s = s_s = None
+    sec, ts, ys = [x[0].copy()], [], []
     for j in range(n_periods):
-        last = samples > 0 and j == n_periods - 1
-        sol = _integrate(rates, x, 0.0, period, rtol, atol, dense=last)
-        x = sol.y[:, -1].reshape(1, -1)
+        keep = j >= n_periods - record
+        end, t, y = flow.one(x, samples if keep else 0)
+        if keep and t is not None:
+            ts.append(t + (len(ts)) * flow.period)
+            ys.append(y[:, 0])
+        x = end
         sec.append(x[0].copy())
-        if last:
-            t_s = np.arange(samples) * (period / samples)
-            s_s = sol.sol(t_s).T
-    return np.array(sec), t_s, s_s
+    if not ts:
+        return np.array(sec), None, None
+    return np.array(sec), np.concatenate(ts), np.concatenate(ys)
 
 
-def loop_verdict(rates: Rates, period: float, s0, **options) -> LoopVerdict:
+def loop_verdict(rates: Rates, period: float, s0, *, reference_turns: int = 0, **options) -> LoopVerdict:
     """The long-run regime of the closed loop s' = rates(t, s) (T = ``period`` s) from s0 (d,), by
     the book's orbit procedure (:func:`lib.dynamics.verdicts.find_orbits`) on :class:`FlowMap`:
     ``transient`` periods, then the last ``history`` section states searched for an orbit of
     period k <= ``max_period`` (up to whole turns of the heading, column 2), Newton with a
     difference Jacobian (step ``fd_step``), Floquet multipliers, the reach test. Options and
     defaults: :data:`LOOP_OPTIONS`. A state that blows up gives ``undecided`` with the time.
+    The heading's turns are counted against the path's: ``reference_turns`` (1 on the circle (27),
+    whose tangent turns once a period; 0 on the eight) are taken off the orbit's, so that an orbit
+    on which the heading follows the circle is ``periodic`` and one that gains turns on it
+    ``slipping``.
 
     Parameters
     ----------
@@ -131,6 +193,8 @@ def loop_verdict(rates: Rates, period: float, s0, **options) -> LoopVerdict:
         T (s), > 0.
     s0 : array_like
         The start (d,), heading in column 2.
+    reference_turns : int
+        Whole turns of the path's heading per period.
     **options
         Keys of :data:`LOOP_OPTIONS`.
 
@@ -138,18 +202,19 @@ def loop_verdict(rates: Rates, period: float, s0, **options) -> LoopVerdict:
     -------
     LoopVerdict
     """
-    o = checks.options(options, LOOP_OPTIONS, minima=dict(transient=1, history=3, max_period=1, newton_iter=1))
+    o = checks.options(options, LOOP_OPTIONS, minima=_INTEGER_OPTIONS)
     if not callable(rates):
         raise TypeError(f"rates must be a callable (t, s) -> s', got {type(rates).__name__}")
     period = checks.number("period", period, positive=True, unit="s")
     s0 = checks.array("s0", s0, ndim=1)
+    reference_turns = checks.integer("reference_turns", reference_turns)
     d = s0.size
     nan = np.full(d, np.nan)
+    flow = FlowMap(rates, period, rtol=o["rtol"], atol=o["atol"], steps=o["steps"])
     try:
-        sec, _, _ = run_periods(rates, period, s0, o["transient"] + o["history"], rtol=o["rtol"], atol=o["atol"])
+        sec, _, _ = run_periods(flow, s0, o["transient"] + o["history"])
     except SimulationError as err:
         return LoopVerdict("undecided", 0, 0, nan, nan + 0j, np.nan, np.nan, f"diverged: {err}", np.empty((0, d)))
-    flow = FlowMap(rates, period, rtol=o["rtol"], atol=o["atol"])
     hist = sec[-o["history"]:, None, :]
     try:
         orb = dv.find_orbits(lambda i, x, k: dv.difference_jacobian(flow, i, x, k, o["fd_step"]), flow,
@@ -163,19 +228,23 @@ def loop_verdict(rates: Rates, period: float, s0, **options) -> LoopVerdict:
         return LoopVerdict("undecided", 0, 0, nan, nan + 0j, float(orb["floquet"][0]), np.nan,
                            f"no attracting orbit reached after {o['transient'] + o['history']} periods ({status})",
                            sec)
-    k, n = int(orb["k"][0]), int(orb["n"][0])
+    k = int(orb["k"][0])
+    n = int(orb["n"][0]) - k * reference_turns
     regime = str(dv.orbit_regime(np.array([n]))[0])
     return LoopVerdict(regime, k, n, orb["x"][0], orb["mult"][0], float(np.abs(orb["mult"][0]).max()),
                        float(orb["distance"][0]), "", sec)
 
 
-def steady_measures(t, states, F, beta, path_z) -> dict:
+def steady_measures(t, states, F, beta, path_z, *, F_cap: float | None = None,
+                    beta_max: float | None = None) -> dict:
     """The steady errors and inputs over one period sampled at equal steps (the last sample one
     step before the period closes): the largest and the RMS distance |C - C_d| (m), the peak
     force F (N) and the peak |beta| (rad), and the range of the heading error p = phi - phi_d
     (rad, continuous). Largest values are refined between samples by parabolas
     (:func:`lib.dynamics.sampled.sampled_extremes`, cyclic; error O(h^3) for a smooth signal, and
-    the sampled value itself at a kink, such as a force held at its cap).
+    the sampled value itself at a kink). A parabola through a force held at its cap would
+    overshoot it: the peaks are taken no higher than ``F_cap`` and ``beta_max``, which the applied
+    inputs never exceed.
 
     Parameters
     ----------
@@ -187,6 +256,8 @@ def steady_measures(t, states, F, beta, path_z) -> dict:
         Applied inputs (N, rad), (n,).
     path_z : array_like
         The path's z_d at t, (n, 3) (x_d, y_d, phi_d).
+    F_cap, beta_max : float, optional
+        The limits the inputs obey (N, rad), None for none.
 
     Returns
     -------
@@ -198,5 +269,10 @@ def steady_measures(t, states, F, beta, path_z) -> dict:
     p = np.unwrap(states[:, 2] - path_z[:, 2])
     top = lambda y: float(max(sampled_extremes(np.asarray(y, dtype=float)[None, :])[1][0], np.max(y)))  # noqa: E731
     pmin, pmax = sampled_extremes(p[None, :], cyclic=False)
-    return dict(max_error=top(dist), rms_error=float(np.sqrt(np.mean(dist**2))), F_peak=top(F),
-                beta_peak=top(np.abs(beta)), p_range=float(pmax[0] - pmin[0]))
+    F_peak, beta_peak = top(F), top(np.abs(beta))
+    if F_cap is not None:
+        F_peak = min(F_peak, float(F_cap))
+    if beta_max is not None:
+        beta_peak = min(beta_peak, float(beta_max))
+    return dict(max_error=top(dist), rms_error=float(np.sqrt(np.mean(dist**2))), F_peak=F_peak,
+                beta_peak=beta_peak, p_range=float(pmax[0] - pmin[0]))

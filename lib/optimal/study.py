@@ -30,7 +30,20 @@ SETTINGS = ((None, PAPER_CAP),) + tuple((a, None) for a in CHAPTER_ANGLES_DEG[::
 
 
 def setting_label(angle_deg, cap) -> str:
-    """'4 N', '30 deg', '30 deg + 4 N': the words of a limit setting."""
+    """'4 N', '30 deg', '30 deg + 4 N': the words of a limit setting.
+
+    Parameters
+    ----------
+    angle_deg : float or None
+        The angle limit (deg), None for none.
+    cap : float or None
+        The force cap (N), None for none.
+
+    Returns
+    -------
+    str
+        The label ('none' without limits).
+    """
     parts = ([] if angle_deg is None else [f"{angle_deg:g} deg"]) + ([] if cap is None else [f"{cap:g} N"])
     return " + ".join(parts) or "none"
 

@@ -23,6 +23,9 @@ from ..tracking.mismatch import mismatch_study
 from ..dynamics.verdicts import held
 from ..percussion import (centre_of_percussion, circle_lock_radius, circle_steady_motion,
                           percussion_fig5_map)
+from ..optimal.compare import limits_study
+from ..optimal.motion import verify_motion
+from ..optimal.study import PAPER_CAP
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from ..rotation.fig5 import fig5_map
 from ..rotation.slow_eight import slow_eight_prediction
@@ -162,6 +165,60 @@ def _check_percussion_map() -> Outcome:
                    "no chaos)")
 
 
+def _chapter8():
+    """Chapter 8's comparison, shared with the chapter (its call, its arguments)."""
+    return cached(limits_study, Body(), Gains(), R0, THETA0)
+
+
+def _check_cap_bound() -> Outcome:
+    st = _chapter8()
+    b, table = st["bound"], st["table"]
+    capped = table[(table.cap == PAPER_CAP) & (table.law != "bound")]
+    bracket = b.max_error_achieved - b.max_error
+    above = bool((capped.max_error >= b.max_error - 10 * b.gap - 1e-9).all())
+    ok = b.max_error > 0.0 and bracket < 0.01 * b.max_error and b.gap < 1e-6 and above   # measured 2.4e-4 m, 6e-10
+    return Outcome(legend_status(bool(ok), extension=True), b.max_error,
+                   "the least largest distance (m) of C from the eight under the 4 N cap, a certified lower bound",
+                   f"a convex relaxation solved by Clarabel (duality gap {b.gap:.0e} m); a motion within "
+                   f"{bracket:.1e} m of it exists; every law of the book under the cap "
+                   f"({len(capped)} rows) leaves at least this")
+
+
+def _check_angle_optimum() -> Outcome:
+    st = _chapter8()
+    table, body = st["table"], Body()
+    worst, below = 0.0, True
+    for (angle, cap), m in st["motions"].items():
+        if cap is None:
+            continue                    # without a cap the force grows with the mesh: no verified limit
+        worst = max(worst, verify_motion(body, m))
+        paper = table[(table.law == "paper") & (table.angle_deg.fillna(-1) == (-1 if angle is None else angle))
+                      & (table.cap == cap)]
+        below &= bool(m.rms_error < float(paper.rms_error.iloc[0]))
+    m30 = st["motions"][(30, PAPER_CAP)]
+    ok = worst < 1e-6 and below                                    # measured 1e-8
+    return Outcome(legend_status(bool(ok), extension=True), m30.rms_error,
+                   "RMS distance (m) of C from the eight of the best motion found under 30 deg and 4 N",
+                   f"direct collocation (IPOPT) on (2)-(4) from several starts; each motion's inputs integrated "
+                   f"by the book's integrator return its state within {worst:.0e}; every one has a smaller RMS "
+                   "error than the paper's law at its setting (an upper bound on the least possible)")
+
+
+def _check_optimal_tracker() -> Outcome:
+    st = _chapter8()
+    opt = st["table"][st["table"].law == "optimal"]
+    rho = float(opt.floquet.max())
+    gap = float(max(abs(r.rms_error - st["motions"][(None if np.isnan(r.angle_deg) else int(r.angle_deg),
+                                                     None if np.isnan(r.cap) else r.cap)].rms_error)
+                    for r in opt.itertuples()))
+    ok = bool((opt.regime == "periodic").all()) and rho < 1.0 and gap < 1e-3      # measured 3e-4 m
+    return Outcome(legend_status(ok, extension=True), rho,
+                   "largest |Floquet multiplier| of the periodic LQR's orbits about the best motions, every setting",
+                   f"decided on the clipped loop's period map (Newton, multipliers, reach test) at {len(opt)} "
+                   f"settings: periodic at each, its RMS error within {gap:.0e} m of the planned motion's; the "
+                   f"paper's start reaches it at {int(opt.paper_start_reached.sum())} of them")
+
+
 def items() -> list[Item]:
     """The extension rows, in the order of the chapters."""
     I = Item  # noqa: E741
@@ -182,4 +239,10 @@ def items() -> list[Item]:
           "chapters/07_percussion", "extended", _check_percussion_circle),
         I("percussion-map", "Sec. 6, extended: Fig. 5 under the law for the centre of percussion",
           "chapters/07_percussion", "extended", _check_percussion_map),
+        I("cap-bound", "Sec. 5, extended: the least error any controller can leave under the 4 N cap",
+          "chapters/08_optimal", "extended", _check_cap_bound),
+        I("angle-optimum", "Sec. 5, extended: the best periodic motions under the angle limits, verified",
+          "chapters/08_optimal", "extended", _check_angle_optimum),
+        I("optimal-tracker", "Sec. 5, extended: a controller that reaches the best motion under the limits",
+          "chapters/08_optimal", "extended", _check_optimal_tracker),
     ]

@@ -13,7 +13,7 @@ __all__ = ["FINDINGS", "findings"]
 FINDINGS = {
     "eq6": "corrected", "thm6": "refuted", "stlc": "refuted", "gas": "refuted", "window": "extended",
     "fig3": "reproduced", "limit-mirror": "extended", "chaos": "reproduced", "fig5": "extended",
-    "weight-limit": "extended", "percussion-map": "extended",
+    "weight-limit": "extended", "percussion-map": "extended", "cap-bound": "extended",
 }
 
 

@@ -13,7 +13,7 @@ from ..integrators.smooth import Integration, SimulationError, integrate
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from ..simulate import DEFAULT_RATE, SimulationResult
 from ..trajectories import Reference, position_kinematics
-from .law import DEFAULT_POLE, closed_loop_rates, error_polynomial
+from .law import ANTI_WINDUP_TIME, DEFAULT_POLE, closed_loop_rates, error_polynomial
 from .point import point_accel, point_state
 
 __all__ = ["PercussionResult", "simulate", "point_error", "reference_point_kinematics", "designed_error_deviation"]
@@ -53,7 +53,8 @@ def reference_point_kinematics(ref: Reference, t) -> tuple:
 
 def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz0=None, *,
              thrust0: float = 0.0, pole: float = DEFAULT_POLE, limits: Limits | None = None, t_eval=None,
-             integration: Integration | None = None) -> PercussionResult:
+             integration: Integration | None = None, anti_windup: bool = False,
+             anti_windup_time: float = ANTI_WINDUP_TIME) -> PercussionResult:
     """Integrate (2)-(4) under the law for P from t = 0 to ``t_end`` (s): P follows the path of
     ``ref`` with its error obeying e''' + k2 e'' + k1 e' + k0 e = 0
     (:func:`lib.percussion.law.error_polynomial` with ``pole``).
@@ -80,6 +81,15 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
         Output times (s), default 20 per second.
     integration : Integration, optional
         Method and tolerances (default DOP853 at 1e-10).
+    anti_windup : bool
+        Anti-windup of the thrust integrator (:mod:`lib.percussion.law`): while a limit is
+        active (the law's F above the cap or its |beta| above the angle limit), the thrust's
+        rate uses the angular acceleration actually applied, and back-calculation
+        (F cos beta - xi) / T_aw (N/s) pulls xi towards the applied thrust F cos beta (N);
+        without saturation xi' = nu exactly. False (default): xi' = nu always (today's law).
+    anti_windup_time : float
+        T_aw (s), > 0, used with ``anti_windup``; default
+        :data:`lib.percussion.law.ANTI_WINDUP_TIME`.
 
     Returns
     -------
@@ -96,6 +106,9 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
     thrust0 = checks.number("thrust0", thrust0, unit="N")
     limits = Limits() if limits is None else checks.instance("limits", limits, Limits)
     integration = Integration() if integration is None else checks.instance("integration", integration, Integration)
+    anti_windup = checks.flag("anti_windup", anti_windup)
+    anti_windup_time = checks.number("anti_windup_time", anti_windup_time, positive=True, unit="s")
+    t_aw = anti_windup_time if anti_windup else None
     coeffs = error_polynomial(body, gains, pole)
     if t_eval is None:
         t_eval = np.linspace(0.0, t_end, int(round(t_end * DEFAULT_RATE)) + 1)
@@ -106,7 +119,7 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
 
     def rhs(t, y):
         k = np.array(kin(t))
-        out = closed_loop_rates(body, coeffs, (k[0:2], k[2:4], k[4:6], k[6:8]), y, limits)[0]
+        out = closed_loop_rates(body, coeffs, (k[0:2], k[2:4], k[4:6], k[6:8]), y, limits, t_aw)[0]
         if not np.all(np.isfinite(out)):
             raise SimulationError(f"closed loop became non-finite at t = {t:.6g} s")
         return out

@@ -1,0 +1,290 @@
+"""Every law of the book under the paper's limits, beside the best motion and the bound
+(Chapter 8's side-by-side table).
+
+At each limit setting (:data:`lib.optimal.study.SETTINGS`) four controllers run from the paper's
+start on the eight: the paper's law (23), (25)-(26); the weighted law of Chapter 6 (the exact
+limited allocation, weights (1, 1, 1)); the law for P of Chapter 7 with its anti-windup; and the
+periodic LQR about the best periodic motion found (:mod:`lib.optimal.tracker`). The first three
+are decided by :func:`lib.optimal.loop.loop_verdict` (the book's orbit procedure), the last by
+:func:`lib.optimal.tracker.motion_verdict`; Chapter 4's verdicts for the paper's law (which also
+decide chaos) are set beside them by the chapter. Each is measured over one period of its orbit,
+or, without one, over the last ``measure_periods`` periods of its run (a horizon's statistics).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+import pandas as pd
+
+from ..allocation import Allocation, Limits, allocate
+from ..closed_loop import ClosedLoop, reference_of
+from ..control import computed_torque
+from ..limits.runs import switched_runs
+from ..limits.verdicts import limit_verdicts
+from ..machinery import checks
+from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
+from ..percussion.law import ANTI_WINDUP_TIME, closed_loop_rates, error_polynomial
+from ..trajectories import POSITIONS, make
+from .bound import cap_bound
+from .loop import FlowMap, loop_verdict, run_periods, steady_measures
+from .study import PAPER_CAP, SETTINGS, limit_motions, setting_label
+from .tracker import periodic_lqr, track_motion
+from .verdict import basin, motion_verdict
+
+__all__ = ["LAWS", "LawLoop", "law_loop", "law_row", "paper_rows", "side_by_side", "WEIGHTS", "THRUST0", "LAW_OPTIONS", "LAW_STEPS", "limits_study"]
+
+#: the laws of the table, in its order
+LAWS = ("paper", "weighted", "percussion", "optimal")
+#: Chapter 6's weights (w_x, w_y, w_phi) for the weighted law under limits
+WEIGHTS = (1.0, 1.0, 1.0)
+#: the law for P's thrust state at the start (N), as Chapter 7 starts it
+THRUST0 = 0.5
+
+
+@dataclass(frozen=True)
+class LawLoop:
+    """One law's closed loop: ``rates(t, s)`` and ``inputs(t, s) -> (F, beta)`` vectorised over
+    rows of states (d = 6, or 7 with the law for P's thrust state), its start ``s0`` (d,)."""
+
+    rates: Callable
+    inputs: Callable
+    s0: np.ndarray
+
+
+def law_loop(body: Body, gains: Gains, ref, law: str, limits: Limits) -> LawLoop:
+    """The closed loop of ``law`` ("paper", "weighted" or "percussion") under ``limits``,
+    started from the paper's start (with the thrust state :data:`THRUST0` for the law for P).
+
+    Parameters
+    ----------
+    body, gains : Body, Gains
+        The body and the gains of (23).
+    ref : Reference
+        The path (:func:`lib.trajectories.make`).
+    law : str
+        One of the first three of :data:`LAWS`.
+    limits : Limits
+        Force and angle limits.
+
+    Returns
+    -------
+    LawLoop
+    """
+    checks.one_of("law", law, LAWS[:3])
+    s0 = np.concatenate([PAPER_Z0, PAPER_DZ0])
+    if law in ("paper", "weighted"):
+        alloc = Allocation() if law == "paper" else Allocation("limited", WEIGHTS)
+        loop = ClosedLoop.of(body, gains, reference_of(ref), alloc, limits)
+
+        def inputs(t, s):
+            return loop.inputs(t, s[..., :3], s[..., 3:])[1:]
+        return LawLoop(lambda t, s: loop.rates(t, s)[0], inputs, s0)
+    coeffs = error_polynomial(body, gains)
+    position = POSITIONS[ref._kind]
+
+    def kin(t):
+        k = np.stack(np.broadcast_arrays(*position(ref.R, ref.theta, np.asarray(t, dtype=float))), -1)
+        return tuple(k[..., 2 * j:2 * j + 2] for j in range(4))
+
+    def both(t, s):
+        return closed_loop_rates(body, coeffs, kin(t), s, limits, ANTI_WINDUP_TIME)
+    return LawLoop(lambda t, s: both(t, s)[0], lambda t, s: both(t, s)[1:], np.r_[s0, THRUST0])
+
+
+def _measure(flow: FlowMap, loop: LawLoop, x, n_periods: int, ref, limits: Limits) -> dict:
+    """steady_measures over ``n_periods`` periods from the state x at t = 0."""
+    _, t, st = run_periods(flow, x, n_periods, samples=512, record=n_periods)
+    F, beta = loop.inputs(t, st)
+    return steady_measures(t, st[:, :6], np.broadcast_to(F, t.shape), np.broadcast_to(beta, t.shape), ref.z(t),
+                           F_cap=limits.force, beta_max=limits.angle)
+
+
+#: the verdict's options for the weighted law and the law for P: classical RK4 with fixed steps
+#: a period (the batch integrator of Chapter 6, whose cost stays bounded where a clipped angle
+#: chatters; 128 for the weighted law, 256 for the law for P, whose clipped angle chatters at
+#: its integrator's fastest rates), 16 periods of transient and 8 searched for an orbit
+LAW_OPTIONS = dict(transient=16, history=8)
+LAW_STEPS = {"weighted": 128, "percussion": 256}
+
+
+def law_row(body: Body, gains: Gains, ref, law: str, limits: Limits, *, measure_periods: int = 4) -> dict:
+    """The weighted law's or the law for P's verdict and measures under ``limits``: the orbit
+    procedure (:func:`lib.optimal.loop.loop_verdict`, :data:`LAW_OPTIONS`) from the paper's start,
+    then one period of the orbit, or, without one, ``measure_periods`` periods from the last state.
+
+    Parameters
+    ----------
+    body, gains : Body, Gains
+        The body and the gains of (23).
+    ref : Reference
+        The path.
+    law : str
+        ``"weighted"`` or ``"percussion"``.
+    limits : Limits
+        Force and angle limits.
+    measure_periods : int
+        Periods measured without an orbit.
+
+    Returns
+    -------
+    dict
+        regime, reason, floquet, and the measures of :func:`lib.optimal.loop.steady_measures`.
+    """
+    checks.one_of("law", law, LAWS[1:3])
+    loop = law_loop(body, gains, ref, law, limits)
+    turns = 1 if ref.__class__.__name__ == "Circle" else 0
+    v = loop_verdict(loop.rates, ref.period, loop.s0, reference_turns=turns, steps=LAW_STEPS[law], **LAW_OPTIONS)
+    if v.reason.startswith("diverged"):
+        return dict(regime="undecided", reason=v.reason, floquet=np.nan, max_error=np.inf, rms_error=np.inf,
+                    F_peak=np.nan, beta_peak=np.nan, p_range=np.nan)
+    flow = FlowMap(loop.rates, ref.period, steps=LAW_STEPS[law])
+    found = bool(np.isfinite(v.orbit).all())
+    meas = _measure(flow, loop, v.orbit if found else v.section[-1], v.period if found else measure_periods,
+                    ref, limits)
+    return dict(regime=v.regime, reason=v.reason, floquet=v.floquet, **meas)
+
+
+def paper_rows(body: Body, gains: Gains, ref, settings=SETTINGS, *, horizon: int = 40, measured: int = 20) -> list:
+    """The paper's law at each setting, decided by Chapter 4's procedure
+    (:func:`lib.limits.verdicts.limit_verdicts`, the compiled switched loop, which also decides
+    chaos) and measured on the same integrator (:func:`lib.limits.runs.switched_runs`, 200 samples
+    a period): over one period of its orbit, or, without one, over the last ``measured`` of
+    ``horizon`` periods from the paper's start.
+
+    Parameters
+    ----------
+    body, gains : Body, Gains
+        The body and the gains of (23).
+    ref : Reference
+        The circle or the eight.
+    settings : sequence of tuple
+        (angle limit in deg or None, cap in N or None).
+    horizon, measured : int
+        Periods run and measured without an orbit.
+
+    Returns
+    -------
+    list of dict
+        One per setting: regime, reason, floquet and the measures.
+    """
+    angles = np.array([math.pi if a is None else math.radians(a) for a, _ in settings])
+    caps = np.array([np.inf if c is None else c for _, c in settings])
+    frame = limit_verdicts(body, gains, ref, angles, caps)[0]
+    rows = []
+    for j, r in frame.iterrows():
+        has_orbit = r.orbit is not None
+        s0 = np.asarray(r.orbit) if has_orbit else np.concatenate([PAPER_Z0, PAPER_DZ0])
+        n, keep = (int(r.period), int(r.period)) if has_orbit else (horizon, measured)
+        run = switched_runs(body, gains, ref, angles[j], caps[j], s0=s0, n_periods=n, samples_per_period=200)
+        m = run.t >= run.t[-1] - keep * ref.period - 1e-9
+        t, st = run.t[m][:-1], run.states[0, m][:-1]
+        tau = computed_torque(body, gains, ref, t, st[:, :3], st[:, 3:])
+        F, beta = allocate(tau, st[:, 2], force_limit=None if np.isinf(caps[j]) else caps[j],
+                           angle_limit=angles[j])
+        meas = steady_measures(t, st, F, beta, ref.z(t), F_cap=None if np.isinf(caps[j]) else caps[j],
+                               beta_max=angles[j])
+        rows.append(dict(regime=r.regime, reason=r.reason, floquet=r.floquet, **meas))
+    return rows
+
+
+#: the optimal motion's controller decided on its period map by RK4 with this many fixed steps on
+#: each input piece (two a collocation interval), from the tracker's seven starts over this many periods
+OPTIMAL_STEPS, OPTIMAL_PERIODS = 2, 8
+
+
+def _optimal_row(body: Body, motion, limits: Limits) -> dict:
+    lqr = periodic_lqr(body, motion)
+    v = motion_verdict(body, motion, limits=limits, lqr=lqr, steps=OPTIMAL_STEPS, periods=OPTIMAL_PERIODS)
+    T = motion.period
+    x = v.x if np.isfinite(v.x).all() else np.concatenate(motion.state(0.0))
+    res = track_motion(body, motion, T, limits=limits, z0=x[:3], dz0=x[3:], lqr=lqr,
+                       t_eval=np.arange(1024) * (T / 1024))
+    meas = steady_measures(res.t, np.c_[res.z, res.dz], res.F, res.beta, res.z_d, F_cap=limits.force,
+                           beta_max=limits.angle)
+    return dict(regime=v.regime, reason=v.reason, floquet=float(np.abs(v.multipliers).max()),
+                paper_start_reached=bool(v.reached[0]), starts_reached=int(v.reached.sum()),
+                starts=int(v.reached.size), **meas)
+
+
+def side_by_side(body: Body, gains: Gains, R: float, Theta: float, motions: dict, bounds: dict, *,
+                 settings=SETTINGS, kind: str = "eight") -> pd.DataFrame:
+    """The table: for each setting (angle limit in deg or None, cap in N or None) the rows of the
+    paper's, the weighted and the percussion law (:func:`law_row`), of the optimal motion's
+    controller, and of the bound where there is a cap.
+
+    Parameters
+    ----------
+    body, gains : Body, Gains
+        The body and the gains of (23).
+    R, Theta : float
+        The path (m, rad/s).
+    motions : dict
+        (angle deg or None, cap or None) -> PeriodicMotion (:func:`lib.optimal.study.limit_motions`).
+    bounds : dict
+        cap (N) -> CapBound (:func:`lib.optimal.bound.cap_bound`) for the settings with a cap.
+    settings : sequence of tuple
+        The settings.
+    kind : str
+        The path.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns setting, angle_deg, cap, law, regime, reason, floquet, max_error, rms_error (m),
+        F_peak (N), beta_peak (rad), p_range (rad).
+    """
+    checks.instance("body", body, Body)
+    checks.instance("gains", gains, Gains)
+    ref = make(kind, R, Theta)
+    paper = paper_rows(body, gains, ref, settings)
+    rows = []
+    for i, (angle, cap) in enumerate(settings):
+        limits = Limits(cap, None if angle is None else math.radians(angle))
+        base = dict(setting=setting_label(angle, cap), angle_deg=angle, cap=cap)
+        rows.append(dict(base, law="paper", **paper[i]))
+        for law in LAWS[1:3]:
+            rows.append(dict(base, law=law, **law_row(body, gains, ref, law, limits)))
+        rows.append(dict(base, law="optimal", **_optimal_row(body, motions[(angle, cap)], limits)))
+        if cap is not None:
+            b = bounds[cap]
+            rows.append(dict(base, law="bound", regime="", reason="", max_error=b.max_error,
+                             rms_error=b.rms_error))
+    return pd.DataFrame(rows)
+
+
+def limits_study(body: Body, gains: Gains, R: float, Theta: float, *, kind: str = "eight") -> dict:
+    """Chapter 8's comparison in one call (cached by the chapter, read by the report): the best
+    motions at every setting (:func:`lib.optimal.study.limit_motions`), the bound under the
+    paper's cap (:func:`lib.optimal.bound.cap_bound`, 256 nodes) and the table
+    (:func:`side_by_side`).
+
+    Returns
+    -------
+    dict
+        ``motions`` (setting -> PeriodicMotion), ``bound`` (CapBound at the paper's cap),
+        ``table`` (pandas.DataFrame), ``basin_setting`` (the first setting whose controller the
+        paper's start does not reach, or the first setting) and ``basin`` (its
+        :func:`lib.optimal.verdict.basin` frame).
+    """
+    motions = limit_motions(body, R, Theta, kind=kind)
+    bound = cap_bound(body, R, Theta, PAPER_CAP, kind=kind)
+    table = side_by_side(body, gains, R, Theta, motions, {PAPER_CAP: bound}, kind=kind)
+    opt = table[table.law == "optimal"]
+    missed = opt[~opt.paper_start_reached.astype(bool)]
+    row = (missed if len(missed) else opt).iloc[0]
+    key = (None if pd.isna(row.angle_deg) else int(row.angle_deg), None if pd.isna(row.cap) else float(row.cap))
+    return dict(motions=motions, bound=bound, table=table, basin_setting=key,
+                basin=_basin(body, motions[key], key))
+
+
+def _basin(body: Body, motion, key) -> pd.DataFrame:
+    """:func:`lib.optimal.verdict.basin` of the best motion's controller at the setting ``key``."""
+    limits = Limits(key[1], None if key[0] is None else math.radians(key[0]))
+    lqr = periodic_lqr(body, motion)
+    v = motion_verdict(body, motion, limits=limits, lqr=lqr, steps=OPTIMAL_STEPS, periods=OPTIMAL_PERIODS)
+    return basin(body, motion, v, limits=limits, lqr=lqr, periods=OPTIMAL_PERIODS, steps=OPTIMAL_STEPS)
+

@@ -1,0 +1,95 @@
+"""lib.optimal.loop: any closed loop decided by the book's orbit procedure, against closed forms."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import linear_sum_assignment
+
+from lib import trajectories
+from lib.allocation import Limits
+from lib.closed_loop import ClosedLoop, reference_of
+from lib.optimal.loop import LOOP_OPTIONS, FlowMap, loop_verdict, run_periods, steady_measures
+from lib.params import PAPER_DZ0, PAPER_Z0, Body, Gains
+from lib.rotation.circle import circle_eigenvalues, circle_equilibria
+
+BODY, GAINS = Body(), Gains()
+R0, TH0 = 2.0, math.pi / 4
+
+
+def _rates(ref, limits=None):
+    loop = ClosedLoop.of(BODY, GAINS, reference_of(ref), limits=limits)
+    return loop, (lambda t, s: loop.rates(t, s)[0])
+
+
+def test_the_paper_circle_is_periodic_with_the_closed_form_multipliers():
+    # uncapped, the position error obeys (24) and the heading (33): the 6-state Jacobian of the
+    # period map is block triangular, its multipliers exp(lambda T) of (24)'s and (35)'s roots
+    ref = trajectories.circle(R0, TH0)
+    _, rates = _rates(ref)
+    v = loop_verdict(rates, ref.period, np.r_[PAPER_Z0, PAPER_DZ0], reference_turns=1)
+    assert v.regime == "periodic" and v.period == 1 and v.turns == 0
+    p0 = circle_equilibria(BODY, R0, TH0)[0]
+    # Newton's point to its tolerance (1e-8) times a few: the orbit is C on the circle, p = p0
+    assert v.orbit[:2] == pytest.approx([R0, 0.0], abs=1e-6)
+    assert math.remainder(v.orbit[2] - math.pi / 2 - p0, 2 * math.pi) == pytest.approx(0.0, abs=1e-6)
+    m, kv, kp = BODY.m, GAINS.kv[0], GAINS.kp[0]
+    pos = np.roots([m, kv, kp]).astype(complex)
+    expected = np.exp(np.r_[pos, pos, circle_eigenvalues(BODY, R0, TH0)] * ref.period)
+    got = np.asarray(v.multipliers)
+    # a forward-difference Jacobian (step 1e-6) of a map integrated at 1e-10: errors ~1e-5 of
+    # the map's derivatives; the pairs matched one to one (linear_sum_assignment)
+    rows, cols = linear_sum_assignment(np.abs(got[:, None] - expected[None, :]))
+    assert np.abs(got[rows] - expected[cols]).max() < 1e-5 * 10
+    assert v.floquet < 1.0
+
+
+def test_the_capped_eight_is_periodic_and_measures_as_the_cap_sweep():
+    # Fig. 4's setting: the compiled cap sweep's largest distance (its own integrator) agrees
+    ref = trajectories.eight(R0, TH0)
+    loop, rates = _rates(ref, Limits(force=4.0))
+    v = loop_verdict(rates, ref.period, np.r_[PAPER_Z0, PAPER_DZ0])
+    assert v.regime == "periodic" and v.turns == 0
+    _, t, st = run_periods(FlowMap(rates, ref.period), v.orbit, 1, samples=1024)
+    _, F, beta = loop.inputs(t, st[:, :3], st[:, 3:])
+    meas = steady_measures(t, st, F, beta, ref.z(t), F_cap=4.0)
+    from lib.tracking.runs import force_cap_sweep
+    sweep = force_cap_sweep(BODY, GAINS, ref, [4.0], n_periods=10)
+    # both sample a period (400 and 1024 points, refined): a parabola's O(h^3) on errors of
+    # 0.4 m, and the sweep's 8 transient periods settled to its slowest multiplier (0.67^8)
+    assert meas["max_error"] == pytest.approx(float(sweep.pos_err_max.iloc[0]), abs=2e-3)
+    assert meas["F_peak"] <= 4.0 and meas["F_peak"] == pytest.approx(4.0, abs=1e-9)
+    assert 0.0 < meas["rms_error"] < meas["max_error"]
+
+
+def test_a_diverging_loop_is_undecided_with_its_time():
+    v = loop_verdict(lambda t, s: s * 50.0, 1.0, np.ones(6), transient=2, history=3)
+    assert v.regime == "undecided" and "diverged" in v.reason
+
+
+def test_a_loop_that_never_settles_is_undecided_not_periodic():
+    # a conservative oscillator at an irrational frequency ratio: no attracting orbit exists
+    w = math.sqrt(2.0)
+
+    def rates(t, s):
+        out = np.zeros_like(s)
+        out[:, 0], out[:, 1] = s[:, 1], -(2 * math.pi * w) ** 2 * s[:, 0] + np.cos(2 * math.pi * t)
+        return out
+
+    v = loop_verdict(rates, 1.0, np.r_[1.0, 0.0, 0.0, 0.0, 0.0, 0.0], transient=4, history=6)
+    assert v.regime == "undecided"
+
+
+@pytest.mark.parametrize("kw, name", [({"period": 0.0}, "period"), ({"s0": [np.nan] * 6}, "s0"),
+                                      ({"reference_turns": 0.5}, "reference_turns"),
+                                      ({"transient": 0}, "transient"), ({"bogus": 1}, "bogus"),
+                                      ({"rates": 3.0}, "rates")])
+def test_bad_arguments_are_refused_before_any_integration(kw, name):
+    args = dict(rates=lambda t, s: pytest.fail("integrated"), period=1.0, s0=np.zeros(6))
+    args.update(kw)
+    with pytest.raises((TypeError, ValueError), match=name):
+        loop_verdict(args.pop("rates"), args.pop("period"), args.pop("s0"), **args)
+
+
+def test_options_are_documented_defaults():
+    assert set(LOOP_OPTIONS) >= {"transient", "history", "max_period", "newton_tol", "reach_tol"}

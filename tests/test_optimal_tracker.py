@@ -1,0 +1,301 @@
+"""The periodic LQR tracker of :mod:`lib.optimal.tracker`, proved on an exact periodic motion:
+the paper's circle (27) run at the stable equilibrium p0 of (33), where F and beta are constant.
+
+Its linearisation is time-invariant in a frame turning with the path, so the periodic Riccati
+solution and the loop's Floquet multipliers have an independent route through the algebraic
+Riccati equation (scipy) and a matrix exponential.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.linalg import expm, solve_continuous_are
+
+from lib.allocation import Limits
+from lib.integrators.smooth import SimulationError
+from lib.model import config_accel, generalized_force
+from lib.optimal import tracker
+from lib.optimal.tracker import RICCATI_SETTLE, RTOL, jacobians, periodic_lqr, track_motion
+from lib.optimal.verdict import motion_verdict
+from lib.params import PAPER_DZ0, PAPER_Z0, Body
+from lib.rotation.circle import circle_equilibria
+
+R_PATH, THETA = 2.0, math.pi / 4
+
+
+class _CircleMotion:
+    """The circle's steady motion: C on C_d = R (cos Th t, sin Th t), phi = Th t + pi/2 + p0,
+    F = |m C_d'' + c C_d'| = R Th sqrt(m^2 Th^2 + c^2), beta = arg(m C_d'' + c C_d') - phi."""
+
+    kind, turns = "circle", 1
+
+    def __init__(self, body: Body, F_max=None, beta_max=None):
+        self.R, self.Theta, self.F_max, self.beta_max = R_PATH, THETA, F_max, beta_max
+        self.period = 2 * math.pi / THETA
+        self.p0 = circle_equilibria(body, R_PATH, THETA)[0]
+        self.F = R_PATH * THETA * math.hypot(body.m * THETA, body.c)
+        self.beta = math.atan2(body.c, -body.m * THETA) - math.pi / 2 - self.p0
+        self.calls = 0
+        self.poison = False
+
+    def state(self, t):
+        self.calls += 1
+        t = np.asarray(t, dtype=float)
+        c, s = np.cos(THETA * t), np.sin(THETA * t)
+        z = np.stack([R_PATH * c, R_PATH * s, THETA * t + math.pi / 2 + self.p0], -1)
+        dz = np.stack([-R_PATH * THETA * s, R_PATH * THETA * c, np.full(t.shape, THETA)], -1)
+        return z, dz
+
+    def inputs(self, t):
+        t = np.asarray(t, dtype=float)
+        F = np.full(t.shape, self.F)
+        if self.poison:
+            F = np.where(t > 0.5, np.nan, F)
+        return F, np.full(t.shape, self.beta)
+
+
+@pytest.fixture(scope="module")
+def body():
+    return Body()
+
+
+@pytest.fixture(scope="module")
+def motion(body):
+    return _CircleMotion(body)
+
+
+@pytest.fixture(scope="module")
+def lqr(body, motion):
+    return periodic_lqr(body, motion)
+
+
+def _x(motion, t):
+    z, dz = motion.state(t)
+    return np.concatenate([z, dz], -1)
+
+
+def _rotating_frame(body, motion, lqr, t):
+    """G(t) (turning the position and velocity blocks by Theta t) and the constant
+    A_r = G'(A G - G_dot), B_r = G' B of the linearisation in the turning frame."""
+    c, s = math.cos(THETA * t), math.sin(THETA * t)
+    G = np.eye(6)
+    G[:2, :2] = G[3:5, 3:5] = [[c, -s], [s, c]]
+    J = np.zeros((6, 6))
+    J[0, 1] = J[3, 4] = -1.0
+    J[1, 0] = J[4, 3] = 1.0
+    F, beta = motion.inputs(np.asarray(t))
+    A, B = jacobians(body, _x(motion, np.asarray(t)), np.stack([F, beta], -1))
+    return G, G.T @ (A @ G - THETA * G @ J), G.T @ B
+
+
+def test_the_test_motion_solves_the_open_loop_model(body, motion):
+    # the motion's own accelerations are those of (2)-(4) under its inputs (closed form vs model)
+    t = np.linspace(0.0, motion.period, 7)
+    z, dz = motion.state(t)
+    ddz = np.stack([-R_PATH * THETA**2 * np.cos(THETA * t), -R_PATH * THETA**2 * np.sin(THETA * t),
+                    np.zeros_like(t)], -1)
+    F, beta = motion.inputs(t)
+    np.testing.assert_allclose(config_accel(body, z, dz, F, beta), ddz, rtol=0, atol=1e-12)
+
+
+def test_analytic_jacobians_match_central_differences_of_config_accel(body):
+    # truncation O(h^2) ~ 1e-12 and rounding ~ eps |f| / h ~ 1e-10 for h = 1e-6: 1e-7 bounds both
+    rng = np.random.default_rng(7)
+    h = 1e-6
+    for _ in range(5):
+        x = rng.uniform(-3, 3, 6)
+        u = np.array([rng.uniform(-1, 5), rng.uniform(-np.pi, np.pi)])
+        A, B = jacobians(body, x, u)
+
+        def f(x, u):
+            return np.concatenate([x[3:], config_accel(body, x[:3], x[3:], u[0], u[1])])
+
+        A_num = np.stack([(f(x + h * e, u) - f(x - h * e, u)) / (2 * h) for e in np.eye(6)], -1)
+        B_num = np.stack([(f(x, u + h * e) - f(x, u - h * e)) / (2 * h) for e in np.eye(2)], -1)
+        np.testing.assert_allclose(A, A_num, rtol=0, atol=1e-7)
+        np.testing.assert_allclose(B, B_num, rtol=0, atol=1e-7)
+
+
+def test_jacobians_broadcast_over_leading_axes(body):
+    x = np.zeros((4, 6))
+    A, B = jacobians(body, x, [2.0, 0.1])
+    assert A.shape == (4, 6, 6) and B.shape == (4, 6, 2)
+    np.testing.assert_array_equal(A[0], jacobians(body, x[0], [2.0, 0.1])[0])
+
+
+def test_periodic_riccati_solution_repeats_and_matches_the_turning_frame_are(body, motion, lqr):
+    # P(T) = P(0) to the settling tolerance it was integrated to
+    assert lqr.repeat < RICCATI_SETTLE
+    assert np.linalg.norm(lqr.P[-1] - lqr.P[0]) / np.linalg.norm(lqr.P[0]) < RICCATI_SETTLE
+    # in the turning frame the problem is time-invariant (the default Q is invariant under the
+    # turn), so P(t) = G(t) P_are G(t)'; agreement to 10 settling tolerances plus 100 RTOL
+    _, A_r, B_r = _rotating_frame(body, motion, lqr, 0.0)
+    P_are = solve_continuous_are(A_r, B_r, lqr.Q, lqr.R)
+    for t in (0.0, 1.3, 5.0, 7.9, 8.0 * 3 + 2.2):
+        G, A_t, B_t = _rotating_frame(body, motion, lqr, t)
+        np.testing.assert_allclose(A_t, A_r, rtol=0, atol=1e-12)      # the frame makes it constant
+        np.testing.assert_allclose(B_t, B_r, rtol=0, atol=1e-12)
+        err = np.abs(lqr.riccati(t) - G @ P_are @ G.T).max() / np.abs(P_are).max()
+        assert err < 10 * RICCATI_SETTLE + 100 * RTOL, (t, err)
+
+
+def test_linearised_closed_loop_multipliers_lie_inside_the_unit_circle_as_the_are_predicts(body, motion, lqr):
+    assert np.all(np.abs(lqr.multipliers) < 1.0)
+    _, A_r, B_r = _rotating_frame(body, motion, lqr, 0.0)
+    K_r = np.linalg.solve(lqr.R, B_r.T @ solve_continuous_are(A_r, B_r, lqr.Q, lqr.R))
+    # G(T) = G(0): the monodromy matrix is exp((A_r - B_r K_r) T), up to the frame
+    expected = np.sort(np.abs(np.linalg.eigvals(expm((A_r - B_r @ K_r) * motion.period))))
+    # the monodromy is integrated at atol = RTOL: entries good to ~1e-9, so 100 RTOL
+    np.testing.assert_allclose(np.sort(np.abs(lqr.multipliers)), expected, rtol=0, atol=100 * RTOL)
+
+
+def test_gain_is_periodic_and_is_r_inverse_b_transpose_p(body, motion, lqr):
+    t = np.array([0.3, 4.1])
+    np.testing.assert_allclose(lqr.gain(t + 2 * motion.period), lqr.gain(t), rtol=0, atol=1e-12)
+    F, beta = motion.inputs(t)
+    _, B = jacobians(body, _x(motion, t), np.stack([F, beta], -1))
+    np.testing.assert_allclose(lqr.gain(t), np.linalg.inv(lqr.R) @ np.swapaxes(B, -1, -2) @ lqr.riccati(t),
+                               rtol=1e-12, atol=1e-12)
+
+
+def test_loop_started_on_the_motion_stays_on_it(body, motion, lqr):
+    z0, dz0 = motion.state(np.asarray(0.0))
+    res = track_motion(body, motion, 2 * motion.period, z0=z0, dz0=dz0, lqr=lqr)
+    z, dz = motion.state(res.t)
+    # the integrator's error at rtol = atol = RTOL over two periods of an attracting loop: 1e3 RTOL
+    assert np.abs(res.z - z).max() < 1e3 * RTOL
+    assert np.abs(res.dz - dz).max() < 1e3 * RTOL
+    assert np.abs(res.F - motion.F).max() < 1e3 * RTOL and np.abs(res.beta - motion.beta).max() < 1e3 * RTOL
+    # the reference in the result is the path's, and tau is the force applied
+    np.testing.assert_allclose(res.z_d[:, :2], z[:, :2], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(res.tau, generalized_force(res.F, res.beta, res.z[:, 2]) * [1, 1, body.a],
+                               rtol=0, atol=1e-15)
+
+
+def test_loop_from_the_paper_start_converges_at_the_rate_of_the_largest_multiplier(body, motion, lqr):
+    T = motion.period
+    res = track_motion(body, motion, 4 * T, lqr=lqr, t_eval=np.arange(5) * T)
+    x = np.concatenate([res.z, res.dz], 1)
+    d = np.abs(x - _x(motion, res.t)).max(axis=1)
+    assert d[0] > 1.0                                             # 1 m and 1.13 rad off at t = 0
+    assert d[-1] < 1e-6 * d[0]
+    # independent route: the nonlinear run contracts per period as the linearised loop's |mu_1|
+    ratio = d[3] / d[2]
+    rho = np.abs(lqr.multipliers[0])
+    assert 0.5 * rho < ratio < 1.5 * rho, (ratio, rho)
+
+
+def test_motion_verdict_finds_the_motion_as_an_attracting_orbit_reached_from_the_paper_start(
+        body, motion, lqr):
+    v = motion_verdict(body, motion, lqr=lqr, periods=4)
+    assert v.regime == "periodic" and v.reason == ""
+    assert np.all(np.abs(v.multipliers) < 1.0)
+    # the motion is an exact orbit of the unclipped loop: Newton's point is the motion's state
+    assert np.abs(v.offset).max() < 100 * tracker.NEWTON_TOL
+    # the multipliers of the nonlinear period map (difference Jacobian) are the linearised loop's
+    # (variational route); the differences of step 1e-5 are good to ~1e-6
+    np.testing.assert_allclose(np.sort(np.abs(v.multipliers)), np.sort(np.abs(lqr.multipliers)), rtol=0, atol=1e-5)
+    assert v.reached.shape == (7,) and v.reached[0]
+    assert v.distance[0] < tracker.REACH_FLOOR
+
+
+def test_the_fixed_step_period_map_decides_alike(body, motion, lqr):
+    # RK4 with 256 steps a period (h = 0.03 s): its map's orbit and multipliers differ from the
+    # adaptive map's by the method's O(h^4) error, ~1e-6 on these states and multipliers
+    v = motion_verdict(body, motion, lqr=lqr, periods=4, steps=256)
+    assert v.regime == "periodic" and v.reached[0]
+    assert np.abs(v.offset).max() < 1e-4
+    np.testing.assert_allclose(np.sort(np.abs(v.multipliers)), np.sort(np.abs(lqr.multipliers)), rtol=0, atol=1e-4)
+
+
+def test_angle_limit_tighter_than_the_motion_s_beta_holds_in_the_result(body, motion, lqr):
+    cap, limit = 4.0, 0.05
+    assert abs(motion.beta) > limit                               # the limit bites on the motion
+    res = track_motion(body, motion, motion.period, lqr=lqr, limits=Limits(force=cap, angle=limit))
+    assert np.all(np.isfinite(res.z))
+    assert np.all(np.abs(res.beta) <= limit) and np.all((res.F >= 0) & (res.F <= cap))
+    assert np.isclose(np.abs(res.beta).max(), limit, rtol=0, atol=0)   # active, not just satisfied
+
+
+def test_the_motion_s_own_limits_apply_when_no_limits_are_given(body):
+    m = _CircleMotion(body, F_max=2.7, beta_max=0.05)
+    res = track_motion(body, m, 2.0, t_eval=np.linspace(0, 2.0, 41))
+    assert np.all(np.abs(res.beta) <= 0.05) and np.all(res.F <= 2.7)
+    assert np.abs(res.beta).max() == 0.05 and res.F.max() == 2.7
+
+
+def test_without_an_angle_limit_a_negative_force_turns_round_and_applies_the_same_force():
+    F, beta = np.array([-2.0, 1.5, -0.3]), np.array([0.3, -2.0, 3.0])
+    F2, beta2 = tracker._saturate(F, beta, math.inf, None)
+    assert np.all(F2 >= 0) and np.all(np.abs(beta2) <= np.pi)
+    # the generalised force (22), torque included, is unchanged: the flip is exact
+    phi = np.array([0.1, 2.0, -1.0])
+    np.testing.assert_allclose(generalized_force(F2, beta2, phi), generalized_force(F, beta, phi), rtol=0, atol=1e-14)
+
+
+def test_a_non_finite_loop_raises_a_simulation_error_naming_the_time(body):
+    m = _CircleMotion(body)
+    gain = periodic_lqr(body, m, samples=64)
+    m.poison = True                                               # F* is NaN after t = 0.5 s
+    with pytest.raises(SimulationError, match=r"t = 0\.5"):
+        track_motion(body, m, 2.0, lqr=gain)
+
+
+BAD = [
+    (dict(body="body"), TypeError, "body"),
+    (dict(motion=object()), TypeError, "motion must have"),
+    (dict(t_end=-1.0), ValueError, "t_end"),
+    (dict(limits=(4.0, 0.5)), TypeError, "limits"),
+    (dict(z0=[1.0, 0.0]), ValueError, "z0"),
+    (dict(dz0=[0.0, np.nan, 0.0]), ValueError, "dz0"),
+    (dict(Q=np.ones((6, 6)) - 2 * np.eye(6)), ValueError, "Q must be positive semi-definite"),
+    (dict(Q=np.triu(np.ones((6, 6)))), ValueError, "Q must be symmetric"),
+    (dict(Q=[1, 1, 1, -1, 1, 1]), ValueError, r"Q\[3\]"),
+    (dict(R_weight=[1.0, 0.0]), ValueError, r"R_weight\[1\]"),
+    (dict(R_weight=np.eye(3)), ValueError, "R_weight must have shape"),
+    (dict(t_eval=[0.0, 3.0, 2.0]), ValueError, "t_eval"),
+]
+
+
+@pytest.mark.parametrize("bad, error, match", BAD)
+def test_track_motion_rejects_a_bad_argument_by_name_before_any_work(body, bad, error, match):
+    m = _CircleMotion(body)
+    args = dict(body=body, motion=m, t_end=4.0) | bad
+    with pytest.raises(error, match=match):
+        track_motion(args.pop("body"), args.pop("motion"), args.pop("t_end"), **args)
+    assert m.calls <= 1                                           # one sample to check the motion
+
+
+def test_a_bad_motion_attribute_is_named(body):
+    for attr, value, match in (("kind", "square", "motion.kind"), ("period", 0.0, "motion.period"),
+                               ("turns", 1.0, "motion.turns"), ("beta_max", 4.0, "motion.beta_max")):
+        m = _CircleMotion(body)
+        setattr(m, attr, value)
+        with pytest.raises((TypeError, ValueError), match=match):
+            periodic_lqr(body, m)
+
+
+def test_motion_verdict_and_periodic_lqr_reject_bad_arguments_by_name(body, motion, lqr):
+    other = _CircleMotion(body)
+    cases = [(lambda: motion_verdict(body, motion, starts=np.zeros((2, 5))), ValueError, "starts"),
+             (lambda: motion_verdict(body, motion, periods=1), ValueError, "periods"),
+             (lambda: motion_verdict(body, motion, lqr="gain"), TypeError, "lqr"),
+             (lambda: motion_verdict(body, other, lqr=lqr), ValueError, "lqr must be"),
+             (lambda: motion_verdict(body, motion, h=0.0), ValueError, "h must be"),
+             (lambda: track_motion(body, motion, 1.0, lqr=lqr, Q=np.eye(6)), ValueError, "either lqr"),
+             (lambda: periodic_lqr(body, other, samples=4), ValueError, "samples"),
+             (lambda: periodic_lqr(Body(m=3.0), other, R_weight=[[1, 2], [2, 1]]), ValueError, "R_weight")]
+    for call, error, match in cases:
+        with pytest.raises(error, match=match):
+            call()
+    assert other.calls <= 3                                       # validation samples only
+
+
+def test_default_starts_are_the_paper_start_and_its_shifts():
+    s = tracker.DEFAULT_STARTS
+    base = np.concatenate([PAPER_Z0, PAPER_DZ0])
+    assert s.shape == (7, 6) and np.array_equal(s[0], base)
+    np.testing.assert_allclose(np.abs(s[1:] - base).max(axis=1), [0.5, 0.5, 0.5, 0.5, np.pi / 2, np.pi / 2])
