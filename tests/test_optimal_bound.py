@@ -42,12 +42,13 @@ def test_interval_map_matches_high_precision_quadrature(h):
     spread = (mpmath.quad(lambda r: w(r) - wbar, [0, r_star])
               - mpmath.quad(lambda r: w(r) - wbar, [r_star, hh])) / m
     im = B.interval_map(BODY, h)
-    # the closed forms against 40-digit quadrature: a few ulps (the spec asks 1e-14 relative)
+    # exact: the closed forms (evaluated without cancellation) against 40-digit quadrature: a few
+    # ulps (the spec asks 1e-14 relative; measured <= 4.4e-16)
     assert im.spread == pytest.approx(float(spread), rel=1e-14, abs=0)
-    assert im.q == pytest.approx(float(wbar / m), rel=1e-14, abs=0)
-    assert im.wbar == pytest.approx(float(wbar), rel=1e-14, abs=0)
-    assert im.a == pytest.approx(float(mpmath.exp(-k * hh)), rel=1e-14, abs=0)
-    assert im.b == pytest.approx(float((1 - mpmath.exp(-k * hh)) / c), rel=1e-14, abs=0)
+    assert im.q == pytest.approx(float(wbar / m), rel=1e-14, abs=0)  # exact: as above
+    assert im.wbar == pytest.approx(float(wbar), rel=1e-14, abs=0)  # exact: as above
+    assert im.a == pytest.approx(float(mpmath.exp(-k * hh)), rel=1e-14, abs=0)  # exact: as above
+    assert im.b == pytest.approx(float((1 - mpmath.exp(-k * hh)) / c), rel=1e-14, abs=0)  # exact: as above
 
 
 def _interval_motion(F_of_r, C0, V0, h, breaks=()):
@@ -86,6 +87,8 @@ def test_every_admissible_force_lands_in_the_relaxed_set_and_the_extreme_remaind
         for al in (1 / im.wbar, -1 / (im.wmax - im.wbar)):
             assert np.linalg.norm(G + al * BODY.m * E) <= F_max * h + tol, name
         if name == "bang-bang":   # the force that makes w - wbar's sign its own reaches |E| = delta
+            # accuracy: solve_ivp rtol 1e-12 on C (order 1 m) against |E| = delta ~ 0.06 m is ~2e-11
+            # relative; 1e-8 allows a factor 500 (measured 3.4e-15)
             assert np.linalg.norm(E) == pytest.approx(delta, rel=1e-8)
         if name == "constant":    # a held force leaves no remainder
             assert np.linalg.norm(E) <= tol
@@ -100,7 +103,10 @@ def test_exact_peak_force_on_the_circle_is_the_closed_form_and_the_demand():
         t = np.linspace(0, ref.period, 101)
         demand = np.linalg.norm(BODY.m * ref.ddz(t)[:, :2] + BODY.c * ref.dz(t)[:, :2], axis=1)
         got = B.exact_peak_force(BODY, R, Theta, kind="circle")
+        # exact: the same closed form, its products in another order (measured <= 1.1e-16)
         assert got == pytest.approx(R * Theta * math.sqrt((BODY.m * Theta) ** 2 + BODY.c**2), rel=1e-15)
+        # exact: an identity, |m C'' + c C'| is constant along the circle; the closed-form
+        # derivatives' rounding only (measured 4.4e-16)
         np.testing.assert_allclose(demand, got, rtol=1e-13)   # constant along the circle
 
 
@@ -126,7 +132,9 @@ def test_exact_peak_force_on_the_eight_is_the_maximum_not_a_sample(R, Theta):
     i = int(np.argmax(d))
     res = minimize_scalar(lambda s: -float(demand(np.array(s))), bounds=(t[i - 1], t[(i + 1) % n] if i + 1 < n
                           else ref.period + t[1]), method="bounded", options={"xatol": 1e-12})
-    assert got == pytest.approx(-res.fun, rel=1e-13)   # a maximum: 1e-12 in time, squared, plus rounding
+    # accuracy: Brent's xatol 1e-12 in time costs its square (~1e-24) at a maximum, leaving rounding
+    # (measured 2.2e-16); an iteration's result, so held at the floor 1e-12
+    assert got == pytest.approx(-res.fun, rel=1e-12)   # a maximum: 1e-12 in time, squared, plus rounding
 
 
 def test_exact_peak_force_broadcasts_is_linear_in_R_and_agrees_with_scalar_calls():
@@ -136,8 +144,9 @@ def test_exact_peak_force_broadcasts_is_linear_in_R_and_agrees_with_scalar_calls
     assert grid.shape == (100, 100)
     for i, j in [(0, 0), (17, 63), (99, 99), (50, 2)]:
         assert grid[i, j] == pytest.approx(B.exact_peak_force(BODY, float(R[i, 0]), float(Theta[0, j])),
-                                           rel=4 * EPS)
+                                           rel=4 * EPS)  # exact: one code path, broadcast vs scalar (measured 0)
     # |F| = R * f(Theta): doubling R doubles it, to rounding
+    # exact: f(Theta) does not depend on R and doubling is exact in binary (measured 0)
     np.testing.assert_allclose(B.exact_peak_force(BODY, 2 * R, Theta), 2 * grid, rtol=4 * EPS)
     circ = B.exact_peak_force(BODY, R, Theta, kind="circle")
     assert np.all(grid > circ)    # the eight swings faster (2 Theta in x) than the circle of the same R
@@ -190,8 +199,10 @@ def test_circle_relaxed_optimum_is_the_symmetric_one(coupled):
     R, F_max, nodes = 2.0, 2.0, 64
     res = B.cap_bound(BODY, R, TH, F_max, kind="circle", nodes=nodes, coupled=coupled)
     want = _circle_reduced_optimum(R, TH, F_max, nodes, coupled)
+    # accuracy: SOLVER_TOL = 100 x Clarabel's tolerance 1e-8 (measured <= 2.1e-9)
     assert res.max_error == pytest.approx(want, abs=SOLVER_TOL)
-    assert res.rms_error == pytest.approx(want, abs=SOLVER_TOL)     # symmetric: every node alike
+    # accuracy: SOLVER_TOL = 100 x Clarabel's tolerance 1e-8; symmetric: every node alike
+    assert res.rms_error == pytest.approx(want, abs=SOLVER_TOL)
 
 
 def test_circle_bracket_closes_on_the_concentric_circle():
@@ -207,6 +218,7 @@ def test_circle_bracket_closes_on_the_concentric_circle():
         widths.append(res.max_error_achieved - res.max_error)
     # the bracket shrinks as O(h^2) (the ratio 1/4); accept anything below 1/2 a doubling
     assert widths[1] < 0.5 * widths[0] and widths[2] < 0.5 * widths[1]
+    # reason: a property, the bracket at 256 nodes is within 0.1 % of the error (measured 2.3e-4)
     assert widths[2] < 1e-3 * exact
 
 
@@ -241,6 +253,8 @@ def test_the_achieved_motion_respects_the_cap_and_is_a_motion_of_the_body():
     h, n, S = res.t[1], len(res.t), 64
     motions = ((res.C, res.V, res.F, "max"), (res.C_rms, res.V_rms, res.F_rms, "rms"))
     for C, V, F, objective in motions:
+        # accuracy: 10 x Clarabel's feasibility tolerance 1e-8 (its defaults; 1e-9 asked), relative to
+        # the cap (measured inside the cap)
         assert np.all(np.linalg.norm(F, axis=1) <= res.F_max * (1 + 1e-7))
         # the full body, eqs. (2)-(4) by lib.model.config_accel, the heading free: F = |F_k|,
         # beta = angle(F_k) - phi, the held force of each interval, from (C_0, V_0) and phi = 0
@@ -256,18 +270,20 @@ def test_the_achieved_motion_respects_the_cap_and_is_a_motion_of_the_body():
             dist.append(np.linalg.norm(sol.sol(r)[:2].T - Cd, axis=1))
             y = sol.y[:, -1]
             nxt = (k + 1) % n
-            # rtol 1e-10 on states of order 1 m and m/s, over 48 restarts: 1e-7 allows a factor 20
+            # accuracy: rtol 1e-10 on states of order 1 m and m/s, over 48 restarts: 1e-7 allows a
+            # factor 20 (measured 5.4e-15)
             np.testing.assert_allclose(y[:2], C[nxt], rtol=0, atol=1e-7)
-            np.testing.assert_allclose(y[3:5], V[nxt], rtol=0, atol=1e-7)
+            np.testing.assert_allclose(y[3:5], V[nxt], rtol=0, atol=1e-7)  # accuracy: as C's above
         d = np.concatenate(dist)
         if objective == "max":
             # samples h/64 apart miss at most |d''| (h/128)^2 / 2 below the peak, |d''| <= |C'' - C_d''|
             # + |C' - C_d'|^2/d, a few m/s^2 here: 10 (h/128)^2 allows that with a margin
-            assert d.max() <= res.max_error_achieved + 1e-7
+            assert d.max() <= res.max_error_achieved + 1e-7  # accuracy: the integration's 1e-7 above
             assert d.max() >= res.max_error_achieved - 10 * (h / 128) ** 2
         else:
             # the periodic trapezoid rule on samples h/64 apart, against Simpson's on h/16: both
-            # within |(d^2)''| (h/16)^4-ish; 1e-6 m on an RMS of 0.28 m is a wide margin for both
+            # within |(d^2)''| (h/16)^4-ish; reason: 1e-6 m on an RMS of 0.28 m is a wide margin for
+            # both (measured 3.6e-10)
             assert math.sqrt(np.mean(d**2)) == pytest.approx(res.rms_error_achieved, abs=1e-6)
 
 

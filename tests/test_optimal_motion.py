@@ -32,8 +32,9 @@ def test_casadi_right_hand_side_equals_config_accel_at_random_states():
     F, beta = rng.uniform(0.0, 10.0, 200), rng.uniform(-4.0, 4.0, 200)
     want = model.config_accel(body, z, dz, F, beta)
     got = np.array(f.map(200)(z.T, dz.T, np.stack([F, beta])).full()).T
-    # the same few flops in another order: rounding only, 1e-12 of the largest term
     scale = np.abs(want).max(axis=1, keepdims=True) + 1.0
+    # exact: the same few flops in another order: rounding only, 1e-12 of the largest term
+    # (measured 1.6e-16)
     np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * scale.max())
 
 
@@ -44,12 +45,16 @@ def test_tableau_is_exact_for_polynomials_of_its_order(degree):
     # a polynomial of degree d is its own interpolant: derivative at the points and end value exact
     p = np.poly1d(rng.normal(size=degree + 1))
     vals = p(tab.tau)
+    # exact: a polynomial identity, up to the rounding of the tableau (measured 2.2e-14 relative)
     np.testing.assert_allclose(vals @ tab.C, np.polyder(p)(tab.tau[1:]), atol=1e-11 * np.abs(p.coeffs).sum() * 10)
+    # exact: a polynomial identity, up to rounding (measured 4.8e-15 relative)
     assert vals @ tab.D == pytest.approx(p(1.0), abs=1e-12 * np.abs(p.coeffs).sum() * 10)
     # Gauss-Legendre quadrature: exact to degree 2 d - 1 (not to 2 d)
     q = np.poly1d(rng.normal(size=2 * degree))
+    # exact: the quadrature identity, up to the rounding of the weights (measured 5e-15 relative)
     assert tab.B @ q(tab.tau[1:]) == pytest.approx(np.polyint(q)(1.0), abs=1e-13 * np.abs(q.coeffs).sum() * 10)
     x2d = np.poly1d([1.0] + [0.0] * (2 * degree))
+    # reason: a property: Gauss's error on x^(2d) is (d!)^4 / ((2d + 1) ((2d)!)^2), 1.4e-6 at d = 5
     assert abs(tab.B @ x2d(tab.tau[1:]) - 1.0 / (2 * degree + 1)) > 1e-6
 
 
@@ -76,20 +81,25 @@ def test_without_limits_the_circle_is_tracked_to_the_collocation_error():
     m16, m32 = (mo.periodic_motion(BODY, R, THETA, kind="circle", nodes=n, starts=("force",)) for n in (16, 32))
     assert m16.turns == 1
     assert m16.rms_error / m32.rms_error >= 10 and m16.max_error / m32.max_error >= 10
-    assert m32.max_error < 1e-5 * R
+    assert m32.max_error < 1e-5 * R   # measured 7.7e-7 R
     # the heading turns once a period, and the integrated motion closes with that turn
+    # exact: the same polynomial at s = 0, plus 2 pi turns (measured 0)
     assert m32.state(m32.period)[0][2] - m32.state(0.0)[0][2] == pytest.approx(2 * math.pi, abs=1e-12)
+    # accuracy: 100 x verify_motion's rtol = atol = 1e-10 (measured 2.1e-10)
     assert mo.verify_motion(BODY, m32) < 1e-8
 
 
 def test_limited_motion_satisfies_its_limits(capped30):
     m = capped30
+    # accuracy: 100 x IPOPT's tol = constr_viol_tol 1e-10 (measured: inside the limits)
     assert np.all(np.abs(m.beta) <= 30 * DEG * (1 + 1e-8))
-    assert np.all(m.F >= -1e-8) and np.all(m.F <= 4.0 * (1 + 1e-8))
+    assert np.all(m.F >= -1e-8) and np.all(m.F <= 4.0 * (1 + 1e-8))  # accuracy: as beta's above
+    # reason: a property, the limit binds (measured within 1.8e-8 of it)
     assert np.any(np.abs(m.beta) > 30 * DEG * (1 - 1e-6))         # the limit binds
     free = mo.periodic_motion(BODY, R, THETA, beta_max=30 * DEG, starts=("force",))
+    # accuracy: 100 x IPOPT's tol = constr_viol_tol 1e-10, as above
     assert np.all(np.abs(free.beta) <= 30 * DEG * (1 + 1e-8)) and np.all(free.F >= -1e-8)
-    assert mo.verify_motion(BODY, free) < 1e-6
+    assert mo.verify_motion(BODY, free) < 1e-6   # measured 8.3e-8 (the default mesh's return error)
 
 
 def test_return_error_shrinks_with_the_mesh_at_the_collocation_order():
@@ -101,29 +111,36 @@ def test_return_error_shrinks_with_the_mesh_at_the_collocation_order():
                                                       starts=("force",)), rtol=1e-12, atol=1e-12)
             for n in (40, 80, 160)]
     assert errs[0] / errs[1] >= 16 and errs[1] / errs[2] >= 16
+    # reason: a property, the finest mesh returns well within 1e-8 (measured 1.4e-10; the check's
+    # integration at 1e-12 adds nothing)
     assert errs[2] < 1e-8
 
 
 def test_verify_motion_catches_inputs_that_do_not_produce_the_motion(capped30):
     bad = replace(capped30, F=capped30.F * (1 + 1e-3))
+    # reason: a property, a 1e-3 change of F misses the motion by far more than its own return
+    # error (measured ratio 1.2e6)
     assert mo.verify_motion(BODY, bad) > 1e3 * mo.verify_motion(BODY, capped30)
 
 
 def test_state_and_inputs_interpolate_the_nodes_and_extend_periodically(capped30):
     m = capped30
     z, dz = m.state(m.t)
-    # t_k N / T is k up to rounding, and the basis moves the value by its slope times that: 1e-12
+    # exact: t_k N / T is k up to rounding, and the basis moves the value by its slope times that:
+    # 1e-12 (measured 6.4e-15)
     np.testing.assert_allclose(z, m.z, rtol=0, atol=1e-12)
-    np.testing.assert_allclose(dz, m.dz, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(dz, m.dz, rtol=0, atol=1e-12)  # exact: as z's above
     F, beta = m.inputs(m.t + 0.5 * m.period / m.nodes)
     np.testing.assert_array_equal(F, m.F)
     np.testing.assert_array_equal(beta, m.beta)
     t = np.linspace(0.0, m.period, 77, endpoint=False)
     for a, b in zip(m.state(t + 2 * m.period), m.state(t)):
+        # exact: one code path, t + 2 T reduced to t up to the rounding of the reduction
         np.testing.assert_allclose(a, b, rtol=0, atol=1e-12 * (1 + np.abs(b).max()))
     np.testing.assert_array_equal(m.inputs(t - m.period)[0], m.inputs(t)[0])
     # each interval's polynomial ends where the next begins (the continuity equations, to IPOPT's tolerance)
     ends = np.einsum("r,kri->ki", col.tableau(m.degree).D, m.collocation)
+    # accuracy: 10 x IPOPT's constr_viol_tol 1e-10 (measured 3.6e-15)
     np.testing.assert_allclose(ends[:-1], m.collocation[1:, 0], rtol=0, atol=1e-9)
 
 
@@ -132,9 +149,12 @@ def test_errors_are_the_distances_from_the_path_on_a_fine_grid(capped30):
     t = np.linspace(0.0, m.period, 200 * m.nodes, endpoint=False)
     d = np.linalg.norm(m.state(t)[0][:, :2] - make("eight", R, THETA).z(t)[:, :2], axis=1)
     # the refined maximum is at least every sample's, and the samples come within their spacing's reach
+    # reason: a property (refined >= sampled), 1e-12 for rounding (measured 1.1e-10 below)
     assert d.max() <= m.max_error + 1e-12
+    # reason: a margin for the samples' spacing (measured 5.9e-10 relative)
     assert m.max_error - d.max() < 1e-6 * m.max_error
-    # the collocation quadrature against the fine grid's mean: both converge to the integral
+    # the collocation quadrature against the fine grid's mean: both converge to the integral;
+    # reason: a margin for both rules' errors, not a bound (measured 5.1e-9)
     assert m.rms_error == pytest.approx(math.sqrt((d**2).mean()), rel=1e-4)
 
 
@@ -148,6 +168,7 @@ def test_a_smaller_angle_limit_cannot_do_better_and_warm_starts_match_cold_ones(
                                   starts=("force",))
         chain.append(prev)
     rms = [m.rms_error for m in chain]
+    # reason: a property (nested feasible sets), 1e-6 relative for IPOPT's stopping at tol 1e-10
     assert all(b >= a * (1 - 1e-6) for a, b in zip(rms, rms[1:])), rms
     assert rms[-1] > 1.2 * rms[0]                       # and the limit costs something
     assert [s[0] for s in chain[-1].starts] == ["force", "guess[0]"]
@@ -155,6 +176,7 @@ def test_a_smaller_angle_limit_cannot_do_better_and_warm_starts_match_cold_ones(
     cold = mo.periodic_motion(BODY, R, THETA, F_max=4.0, beta_max=30 * DEG)
     assert [s[0] for s in warm.starts] == ["guess[0]"]
     assert [s[0] for s in cold.starts] == ["paper", "force", "shifted+", "shifted-"]
+    # reason: a property (the same optimum), 1e-6 relative for IPOPT's stopping (measured 2.2e-15)
     assert warm.rms_error <= cold.rms_error * (1 + 1e-6)
 
 

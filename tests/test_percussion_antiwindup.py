@@ -70,7 +70,7 @@ def test_anti_windup_pulls_the_thrust_state_towards_the_applied_thrust():
     sat = (F0 > CAP) | (np.abs(b0) > math.pi / 4)
     assert sat.all()
     want = (F * np.cos(beta) - y[:, 6]) / ANTI_WINDUP_TIME
-    # exact up to the rounding of nu (N/s) in the difference
+    # exact: the back-calculation term in closed form, up to the rounding of nu (N/s) in the difference
     np.testing.assert_allclose(aw[:, 6] - base[:, 6], want, rtol=1e-12, atol=1e-12 * np.abs(base[:, 6]).max())
     # the correction points from xi to the applied thrust
     assert np.all(np.sign(aw[:, 6] - base[:, 6]) == np.sign(F * np.cos(beta) - y[:, 6]))

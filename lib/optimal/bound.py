@@ -49,7 +49,7 @@ __all__ = ["IntervalMap", "interval_map", "exact_peak_force", "CapBound", "cap_b
 MAX_NODES = 20000
 #: sub-samples per node interval where the achieved motions are evaluated
 SUBSAMPLES = 16
-#: Clarabel's stopping tolerances, tried in turn: 1e-9, then its defaults (1e-8) where the first
+#: Clarabel's stopping tolerances, tried in turn; 1e-9, then its defaults (1e-8) where the first
 #: ends short of them ("AlmostSolved", which a mesh of the eight meets now and then); a solve that
 #: meets neither raises
 SOLVER_OPTIONS = ({"tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9, "tol_feas": 1e-9}, {})

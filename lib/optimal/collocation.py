@@ -39,13 +39,13 @@ __all__ = ["Tableau", "tableau", "casadi_accel", "accel_function", "Transcriptio
 
 #: IPOPT return statuses accepted as a solution
 ACCEPTED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
-#: IPOPT options: silent, a tolerance well below the collocation error at the default mesh, an
+#: IPOPT options; silent, a tolerance well below the collocation error at the default mesh, an
 #: iteration cap (a start that does not converge within it is reported, not used), and a failure
 #: returned as a status for the caller to judge rather than raised
 IPOPT_OPTIONS = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.max_iter": 400,
                  "error_on_fail": False,
                  "ipopt.tol": 1e-10, "ipopt.constr_viol_tol": 1e-10}
-#: the state's length: x, y, phi, x', y', phi'
+#: the state's length; x, y, phi, x', y', phi'
 NX = 6
 
 

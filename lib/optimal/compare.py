@@ -6,7 +6,7 @@ start on the eight: the paper's law (23), (25)-(26); the weighted law of Chapter
 limited allocation, weights (1, 1, 1)); the law for P of Chapter 7 with its anti-windup; and the
 periodic LQR about the best periodic motion found (:mod:`lib.optimal.tracker`). The first three
 are decided by :func:`lib.optimal.loop.loop_verdict` (the book's orbit procedure), the last by
-:func:`lib.optimal.tracker.motion_verdict`; Chapter 4's verdicts for the paper's law (which also
+:func:`lib.optimal.verdict.motion_verdict`; Chapter 4's verdicts for the paper's law (which also
 decide chaos) are set beside them by the chapter. Each is measured over one period of its orbit,
 or, without one, over the last ``measure_periods`` periods of its run (a horizon's statistics).
 """
@@ -35,7 +35,8 @@ from .study import PAPER_CAP, SETTINGS, limit_motions, setting_label
 from .tracker import periodic_lqr, track_motion
 from .verdict import basin, motion_verdict
 
-__all__ = ["LAWS", "LawLoop", "law_loop", "law_row", "paper_rows", "side_by_side", "WEIGHTS", "THRUST0", "LAW_OPTIONS", "LAW_STEPS", "limits_study"]
+__all__ = ["LAWS", "LawLoop", "law_loop", "law_row", "paper_rows", "side_by_side", "WEIGHTS", "THRUST0",
+           "LAW_OPTIONS", "LAW_STEPS", "limits_study", "LAW_NAMES", "error_table", "regime_table", "tracker_table"]
 
 #: the laws of the table, in its order
 LAWS = ("paper", "weighted", "percussion", "optimal")
@@ -103,7 +104,7 @@ def _measure(flow: FlowMap, loop: LawLoop, x, n_periods: int, ref, limits: Limit
                            F_cap=limits.force, beta_max=limits.angle)
 
 
-#: the verdict's options for the weighted law and the law for P: classical RK4 with fixed steps
+#: the verdict's options for the weighted law and the law for P; classical RK4 with fixed steps
 #: a period (the batch integrator of Chapter 6, whose cost stays bounded where a clipped angle
 #: chatters; 128 for the weighted law, 256 for the law for P, whose clipped angle chatters at
 #: its integrator's fastest rates), 16 periods of transient and 8 searched for an orbit
@@ -288,3 +289,73 @@ def _basin(body: Body, motion, key) -> pd.DataFrame:
     v = motion_verdict(body, motion, limits=limits, lqr=lqr, steps=OPTIMAL_STEPS, periods=OPTIMAL_PERIODS)
     return basin(body, motion, v, limits=limits, lqr=lqr, periods=OPTIMAL_PERIODS, steps=OPTIMAL_STEPS)
 
+
+
+#: the table's names of the laws
+LAW_NAMES = {"paper": "paper's law", "weighted": "weighted (Ch. 6)", "percussion": "law for P (Ch. 7)",
+             "optimal": "best motion + LQR", "bound": "bound"}
+
+
+def error_table(table: pd.DataFrame) -> pd.DataFrame:
+    """:func:`side_by_side`'s table as the page shows it: one row a setting, one column a law, each
+    cell "largest / RMS" distance (m, three significant digits), "diverges" where the run blew up
+    and "-" where there is no row (no bound without a cap).
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The frame of :func:`side_by_side`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Index the settings in the table's order; columns the laws' names.
+    """
+    def cell(r):
+        return "diverges" if not np.isfinite(r.max_error) else f"{r.max_error:.3g} / {r.rms_error:.3g}"
+
+    order = list(dict.fromkeys(table.setting))
+    return (table.assign(v=table.apply(cell, axis=1)).pivot(index="setting", columns="law", values="v")
+            .reindex(order)[list(LAW_NAMES)].fillna("-").rename(columns=LAW_NAMES))
+
+
+def regime_table(table: pd.DataFrame) -> pd.DataFrame:
+    """The regimes of :func:`side_by_side`'s table, one row a setting, one column a law.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The frame of :func:`side_by_side`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Index the settings; columns the four controllers' names.
+    """
+    order = list(dict.fromkeys(table.setting))
+    laws = [k for k in LAW_NAMES if k != "bound"]
+    return (table[table.law != "bound"].pivot(index="setting", columns="law", values="regime")
+            .reindex(order)[laws].rename(columns=LAW_NAMES))
+
+
+def tracker_table(table: pd.DataFrame) -> pd.DataFrame:
+    """The best motions' controllers from :func:`side_by_side`'s table: setting, regime, largest
+    |multiplier|, starts reached, whether the paper's start is, largest and RMS distance (m).
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The frame of :func:`side_by_side`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row a setting, the cells formatted for the page.
+    """
+    opt = table[table.law == "optimal"]
+    return pd.DataFrame({
+        "setting": opt.setting, "regime": opt.regime,
+        "largest |multiplier|": opt.floquet.map("{:.3f}".format),
+        "starts reached": [f"{int(r)} of {int(n)}" for r, n in zip(opt.starts_reached, opt.starts)],
+        "paper's start": opt.paper_start_reached.map({True: "yes", False: "no"}),
+        "largest (m)": opt.max_error.map("{:.3g}".format), "RMS (m)": opt.rms_error.map("{:.3g}".format)})

@@ -56,7 +56,7 @@ __all__ = ["DENSE_STEPS", "CANDIDATES", "GOLDEN_ITERATIONS", "RK4_SUBSTEPS", "ex
 DENSE_STEPS = 2048
 #: sampled local maxima refined per point
 CANDIDATES = 4
-#: golden-section iterations of the refinement: the bracket of two steps (2 * 2 pi / DENSE_STEPS
+#: golden-section iterations of the refinement; the bracket of two steps (2 * 2 pi / DENSE_STEPS
 #: in phase) shrinks by 0.618^36 to about 2e-10, which moves F by a relative (2e-10)^2 F''/F
 GOLDEN_ITERATIONS = 36
 #: classical Runge-Kutta substeps of the heading from a sample to a point of its bracket (P)

@@ -33,14 +33,14 @@ __all__ = ["FlowMap", "LoopVerdict", "loop_verdict", "run_periods", "steady_meas
 
 Rates = Callable[[float, np.ndarray], np.ndarray]
 
-#: a state beyond this magnitude (m, rad, m/s, rad/s) has blown up: the bound of
+#: a state beyond this magnitude (m, rad, m/s, rad/s) has blown up; the bound of
 #: :class:`lib.integrators.smooth.Integration`
 BLOWUP = Integration.blowup
 
-#: the procedure's settings here (state units: m, rad, m/s, rad/s): periods run before the orbit
+#: the procedure's settings here (state units; m, rad, m/s, rad/s); periods run before the orbit
 #: search, section states kept, longest period tried, and the tolerances of
 #: :func:`lib.dynamics.verdicts.find_orbits`; the integration's tolerances
-#: (``steps`` = 0: adaptive DOP853 at rtol, atol; ``steps`` > 0: classical RK4 with that many
+#: (``steps`` = 0; adaptive DOP853 at rtol, atol; ``steps`` > 0; classical RK4 with that many
 #: fixed steps a period, the batch integrator of Chapter 6, whose cost does not grow where a
 #: clipped angle chatters across its switching surface)
 LOOP_OPTIONS = dict(transient=24, history=12, max_period=4, candidate_tol=1e-3, newton_tol=1e-8, reach_tol=1e-4,

@@ -43,7 +43,7 @@ __all__ = ["PeriodicMotion", "periodic_motion", "verify_motion", "STARTS", "MAX_
 STARTS = ("paper", "force", "shifted")
 #: the largest mesh accepted (intervals per period)
 MAX_NODES = 2000
-#: the bound on |beta| (rad) when no angle limit is given: beta is then free, but bounded a
+#: the bound on |beta| (rad) when no angle limit is given; beta is then free, but bounded a
 #: little beyond +-pi to keep the NLP bounded (every force direction stays reachable)
 FREE_ANGLE = math.pi + 1.0
 #: the shift of the "shifted" starts' heading when no angle limit is given (rad)
@@ -64,11 +64,14 @@ class PeriodicMotion:
     ----------
     t : numpy.ndarray
         (nodes,) node times t_k = k T / nodes in [0, T) (s).
-    z, dz : numpy.ndarray
-        (nodes, 3) the configuration (x (m), y (m), phi (rad)) and its rate (m/s, m/s, rad/s)
-        at the nodes.
-    F, beta : numpy.ndarray
-        (nodes,) the inputs on the interval starting at t_k: force (N) and angle (rad).
+    z : numpy.ndarray
+        (nodes, 3) the configuration (x (m), y (m), phi (rad)) at the nodes.
+    dz : numpy.ndarray
+        (nodes, 3) its rate (m/s, m/s, rad/s).
+    F : numpy.ndarray
+        (nodes,) the force (N) on the interval starting at t_k.
+    beta : numpy.ndarray
+        (nodes,) its angle (rad) on the same interval.
     max_error : float
         max_t |C - C_d(t)| (m) over the period, on the collocation polynomials (16 samples
         per interval, the largest refined by a bounded scalar search).
@@ -76,9 +79,22 @@ class PeriodicMotion:
         sqrt((1/T) int_0^T |C - C_d|^2 dt) (m) by the collocation quadrature.
     period : float
         T = 2 pi / Theta (s).
-    kind, R, Theta, F_max, beta_max, nodes, degree, turns :
-        The path (``"eight"`` or ``"circle"``), its size (m) and rate (rad/s), the limits
-        (N, rad; None if absent), the mesh, and n (the heading gains 2 pi n per period).
+    kind : str
+        The path, ``"eight"`` or ``"circle"``.
+    R : float
+        Its size (m).
+    Theta : float
+        Its rate (rad/s).
+    F_max : float or None
+        The force cap (N), None if absent.
+    beta_max : float or None
+        The angle limit (rad), None if absent.
+    nodes : int
+        Collocation intervals a period.
+    degree : int
+        Collocation degree.
+    turns : int
+        n, the heading gains 2 pi n per period.
     starts : tuple
         One (start name, rms objective (m) or nan, IPOPT status) per start tried.
     collocation : numpy.ndarray

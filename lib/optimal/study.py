@@ -18,13 +18,13 @@ from .bound import cap_bound, exact_peak_force
 from .motion import PeriodicMotion, periodic_motion, verify_motion
 
 __all__ = ["PAPER_CAP", "CHAPTER_ANGLES_DEG", "SETTINGS", "setting_label", "cap_sweep", "cap_convergence",
-           "limit_motions", "motion_convergence"]
+           "limit_motions", "motion_convergence", "convergence_table", "motions_table", "mesh_table"]
 
 #: the paper's force cap (N), Fig. 4
 PAPER_CAP = 4.0
 #: Chapter 4's chosen angle limits (deg), in the order of the continuation (the largest first)
 CHAPTER_ANGLES_DEG = (90, 60, 45, 30)
-#: the limit settings of Chapter 8's comparison: (angle limit (deg) or None, cap (N) or None)
+#: the limit settings of Chapter 8's comparison; (angle limit (deg) or None, cap (N) or None)
 SETTINGS = ((None, PAPER_CAP),) + tuple((a, None) for a in CHAPTER_ANGLES_DEG[::-1]) \
     + tuple((a, PAPER_CAP) for a in CHAPTER_ANGLES_DEG[::-1])
 
@@ -162,3 +162,65 @@ def motion_convergence(body: Body, R: float, Theta: float, beta_max: float, F_ma
         rows.append(dict(nodes=n, rms_error=m.rms_error, max_error=m.max_error, F_peak=float(m.F.max()),
                          return_error=verify_motion(body, m)))
     return pd.DataFrame(rows)
+
+
+def convergence_table(conv: pd.DataFrame) -> pd.DataFrame:
+    """:func:`cap_convergence`'s frame as the page shows it: nodes, the largest distance's bound
+    and achieved value, the RMS distance's, and the duality gap (m).
+
+    Parameters
+    ----------
+    conv : pandas.DataFrame
+        The frame of :func:`cap_convergence`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Six columns, formatted.
+    """
+    return pd.DataFrame({"nodes": conv.nodes, "largest, bound (m)": conv.max_error.map("{:.5f}".format),
+                         "largest, achieved (m)": conv.max_error_achieved.map("{:.5f}".format),
+                         "RMS, bound (m)": conv.rms_error.map("{:.5f}".format),
+                         "RMS, achieved (m)": conv.rms_error_achieved.map("{:.5f}".format),
+                         "duality gap (m)": conv.gap.map("{:.0e}".format)})
+
+
+def motions_table(motions: dict) -> pd.DataFrame:
+    """The best motions of :func:`limit_motions` under the angle limits: angle limit (deg), cap,
+    RMS and largest distance (m), peak force (N).
+
+    Parameters
+    ----------
+    motions : dict
+        (angle deg or None, cap or None) -> PeriodicMotion.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row a motion with an angle limit, formatted.
+    """
+    rows = [{"angle limit (deg)": a, "cap (N)": "none" if c is None else f"{c:g}",
+             "RMS distance (m)": f"{m.rms_error:.3g}", "largest (m)": f"{m.max_error:.3g}",
+             "peak F (N)": f"{float(m.F.max()):.2f}"} for (a, c), m in motions.items() if a is not None]
+    return pd.DataFrame(rows)
+
+
+def mesh_table(conv: dict) -> pd.DataFrame:
+    """:func:`motion_convergence`'s frames by cap, as the page shows them: cap, intervals, RMS
+    distance (m), peak force (N), return error (the state's max-norm mismatch).
+
+    Parameters
+    ----------
+    conv : dict
+        Cap (N or None) -> frame of :func:`motion_convergence`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Formatted rows.
+    """
+    return pd.concat([pd.DataFrame({"cap": "none" if c is None else f"{c:g} N", "intervals": f.nodes,
+                                    "RMS distance (m)": f.rms_error.map("{:.4f}".format),
+                                    "peak F (N)": f.F_peak.map("{:.2f}".format),
+                                    "return error": f.return_error.map("{:.1e}".format)})
+                      for c, f in conv.items()], ignore_index=True)

@@ -35,20 +35,20 @@ __all__ = ["PeriodicLQR", "jacobians", "periodic_lqr", "track_motion",
            "REACH_FLOOR", "MAX_RICCATI_PERIODS", "RICCATI_SETTLE", "DEFAULT_STARTS"]
 
 #: default state weight (SI), Bryson's rule (1 / acceptable error^2) at the errors to recover from (the
-#: paper's start: 1 m, 1.1 rad off the circle's motion): 1 m, 3.2 rad, 1 m/s, 3.2 rad/s cost alike. With
+#: paper's start; 1 m, 1.1 rad off the circle's motion); 1 m, 3.2 rad, 1 m/s, 3.2 rad/s cost alike. With
 #: 100 times the position weight the loop diverges from the paper's start (beta swings far from beta*)
 DEFAULT_Q = np.diag([1.0, 1.0, 0.1, 1.0, 1.0, 0.1])
-#: default input weight for u = (F, beta): 1 N (the paper's forces are 1 to 4 N) costs as 1 rad, as 1 m
+#: default input weight for u = (F, beta); 1 N (the paper's forces are 1 to 4 N) costs as 1 rad, as 1 m
 DEFAULT_R = np.diag([1.0, 1.0])
-#: rtol (and atol) of every integration here: the Riccati equation, the closed loop, the period map
+#: rtol (and atol) of every integration here; the Riccati equation, the closed loop, the period map
 RTOL = 1e-9
 #: Newton's residual (max-norm, the state's units; 100 RTOL), steps, steps before it must halve
 NEWTON_TOL, NEWTON_ITER, NEWTON_STALL = 1e-7, 12, 4
-#: reached: section distance below REACH_TOL and shrinking as |mu_1| allows, or below REACH_FLOOR (10 NEWTON_TOL)
+#: reached; section distance below REACH_TOL and shrinking as |mu_1| allows, or below REACH_FLOOR (10 NEWTON_TOL)
 REACH_TOL, REACH_FLOOR = 1e-3, 1e-6
 #: periods of the Riccati equation at most; relative change of P(0) a period for P periodic
 MAX_RICCATI_PERIODS, RICCATI_SETTLE = 50, 1e-8
-#: motion_verdict's 7 starts at t = 0: the paper's, then it +-0.5 m in x, +-0.5 m in y, +-pi/2 rad in phi
+#: motion_verdict's 7 starts at t = 0; the paper's, then it +-0.5 m in x, +-0.5 m in y, +-pi/2 rad in phi
 DEFAULT_STARTS = np.concatenate([PAPER_Z0, PAPER_DZ0]) + np.array(
     [np.zeros(6)] + [sign * d * np.eye(6)[j] for j, d in ((0, 0.5), (1, 0.5), (2, np.pi / 2)) for sign in (1, -1)])
 _MOTION_ATTRS = ("period", "kind", "R", "Theta", "F_max", "beta_max", "turns", "state", "inputs")
@@ -367,7 +367,7 @@ def track_motion(body: Body, motion, t_end: float, *, limits: Limits | None = No
     """The body under the periodic LQR about ``motion``, limits enforced, from t = 0 to ``t_end``.
 
     u = u*(t) - K(t) (x - x*(t)), the heading error phi - phi*(t) unwrapped, then clipped
-    (:func:`_saturate`): F_max is ``limits.force``, else ``motion.F_max``, else none; beta_max
+    (``_saturate``): F_max is ``limits.force``, else ``motion.F_max``, else none; beta_max
     ``limits.angle``, else ``motion.beta_max``, else none. DOP853 at rtol = atol = :data:`RTOL`,
     piece by piece between the input breaks.
 

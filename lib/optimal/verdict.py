@@ -73,27 +73,27 @@ def _period_map(lqr: PeriodicLQR, F_max, beta_max, steps: int = 0):
 
 def motion_verdict(body: Body, motion, *, limits: Limits | None = None, starts=None, periods: int = 20,
                    lqr: PeriodicLQR | None = None, h: float = 1e-5, steps: int = 0) -> MotionVerdict:
-    """Decide the clipped closed loop of :func:`track_motion` with the book's procedure.
+    """Decide the clipped closed loop of :func:`lib.optimal.tracker.track_motion` with the book's procedure.
 
-    Newton (:func:`lib.dynamics.orbits.newton`, tol :data:`NEWTON_TOL`, :data:`NEWTON_ITER` steps,
-    after :data:`NEWTON_STALL` only while the residual halves) on the period map P (one period of
+    Newton (:func:`lib.dynamics.orbits.newton`, tol :data:`lib.optimal.tracker.NEWTON_TOL`, :data:`lib.optimal.tracker.NEWTON_ITER` steps,
+    after :data:`lib.optimal.tracker.NEWTON_STALL` only while the residual halves) on the period map P (one period of
     the loop from a state at t = 0 mod T), P(x) = x + (0, 0, 2 pi turns, 0, 0, 0), from the
     motion's state at 0; the Jacobian by central differences of step ``h`` (the state's units).
     "periodic" when Newton converges and every Floquet
     multiplier lies inside the unit circle, else "undecided" with the reason. Then each of
-    ``starts`` ((S, 6) states at t = 0, default :data:`DEFAULT_STARTS`) runs ``periods`` (>= 2)
+    ``starts`` ((S, 6) states at t = 0, default :data:`lib.optimal.tracker.DEFAULT_STARTS`) runs ``periods`` (>= 2)
     periods and has reached the orbit (:func:`lib.dynamics.verdicts.reached`, tol
-    :data:`REACH_TOL`, floor :data:`REACH_FLOOR`) when its last section distance is below the
+    :data:`lib.optimal.tracker.REACH_TOL`, floor :data:`lib.optimal.tracker.REACH_FLOOR`) when its last section distance is below the
     tolerance and has shrunk since ``periods // 2`` periods before as |mu_1| allows.
 
     Parameters
     ----------
     body, motion, limits, lqr
-        As in :func:`track_motion` (``lqr`` default: :func:`periodic_lqr`'s default weights).
+        As in :func:`lib.optimal.tracker.track_motion` (``lqr`` default: :func:`periodic_lqr`'s default weights).
     starts, periods, h
         See above.
     steps : int
-        0: the period map by adaptive DOP853 (:data:`RTOL`) piece by piece; > 0: classical RK4 with
+        0: the period map by adaptive DOP853 (:data:`lib.optimal.tracker.RTOL`) piece by piece; > 0: classical RK4 with
         ``steps`` fixed steps on each input piece (the map of the discretised loop, far cheaper
         where the clipping kinks the field at the orbit).
 
@@ -147,7 +147,7 @@ def basin(body: Body, motion, verdict: MotionVerdict, *, limits: Limits | None =
     """Which starts the controller brings to the orbit of ``verdict``: the paper's start at rest
     moved by each heading offset (rad) and each offset of x (m), run ``periods`` periods on the
     period map of :func:`motion_verdict` (``steps`` as there); reached when the final section
-    distance to the orbit point (max-norm) is below :data:`REACH_TOL`.
+    distance to the orbit point (max-norm) is below :data:`lib.optimal.tracker.REACH_TOL`.
 
     Returns
     -------
