@@ -296,6 +296,13 @@ LAW_NAMES = {"paper": "paper's law", "weighted": "weighted (Ch. 6)", "percussion
              "optimal": "best motion + LQR", "bound": "bound"}
 
 
+def _by_setting(table: pd.DataFrame, values: str, laws) -> pd.DataFrame:
+    """One row a setting (in the table's order), one column a law of ``laws`` (by its name)."""
+    order = list(dict.fromkeys(table.setting))
+    return table.pivot(index="setting", columns="law", values=values).reindex(order)[list(laws)] \
+        .rename(columns=LAW_NAMES)
+
+
 def error_table(table: pd.DataFrame) -> pd.DataFrame:
     """:func:`side_by_side`'s table as the page shows it: one row a setting, one column a law, each
     cell "largest / RMS" distance (m, three significant digits), "diverges" where the run blew up
@@ -314,9 +321,7 @@ def error_table(table: pd.DataFrame) -> pd.DataFrame:
     def cell(r):
         return "diverges" if not np.isfinite(r.max_error) else f"{r.max_error:.3g} / {r.rms_error:.3g}"
 
-    order = list(dict.fromkeys(table.setting))
-    return (table.assign(v=table.apply(cell, axis=1)).pivot(index="setting", columns="law", values="v")
-            .reindex(order)[list(LAW_NAMES)].fillna("-").rename(columns=LAW_NAMES))
+    return _by_setting(table.assign(v=table.apply(cell, axis=1)), "v", LAW_NAMES).fillna("-")
 
 
 def regime_table(table: pd.DataFrame) -> pd.DataFrame:
@@ -332,10 +337,7 @@ def regime_table(table: pd.DataFrame) -> pd.DataFrame:
     pandas.DataFrame
         Index the settings; columns the four controllers' names.
     """
-    order = list(dict.fromkeys(table.setting))
-    laws = [k for k in LAW_NAMES if k != "bound"]
-    return (table[table.law != "bound"].pivot(index="setting", columns="law", values="regime")
-            .reindex(order)[laws].rename(columns=LAW_NAMES))
+    return _by_setting(table[table.law != "bound"], "regime", [k for k in LAW_NAMES if k != "bound"])
 
 
 def tracker_table(table: pd.DataFrame) -> pd.DataFrame:
