@@ -182,6 +182,10 @@ def _limit_chunk(b, f, S0, *, body, gains, ref, o, steps_per_period):
     orb = dv.find_orbits(step, pmap, idx, hist, max_period=kmax, candidate_tol=o["candidate_tol"],
                          newton_tol=o["newton_tol"], reach_tol=o["approach_tol"], reach_floor=o["reach_tol"],
                          newton_options=_NEWTON, fixed_turns=False, ends=2 * kmax)
+    found = orb["found"]
+    # the turns against the path's heading: on the circle (27) phi_d itself turns once a period,
+    # so an orbit that follows it gains k turns per k periods and still holds the heading
+    orb["n"] = np.where(found, orb["n"] - orb["k"] * _reference_turns(ref), orb["n"])
     sec = runs.errors[:, ntr:]
     returns = dv.section_returns(np.moveaxis(sec, 0, 1), angles=(4,))
     regime, reason = dv.classify(lamT, seT, returns, band=o["lyapunov_band"], return_tol=o["return_tol"],
@@ -196,7 +200,6 @@ def _limit_chunk(b, f, S0, *, body, gains, ref, o, steps_per_period):
         reason[spiral] = [f"slow spiral onto an attracting orbit inside the curve (|mu| = {m:.4f})" for m in mu[spiral]]
     tried = ~orb["found"] & (orb["status"] != "") & (regime == "undecided")
     reason[tried] = [f"{_STATUS[s]}; {r}" for s, r in zip(orb["status"][tried], reason[tried])]
-    found = orb["found"]
     mu[found] = orb["rho"][found]
     regime[found] = dv.orbit_regime(orb["n"][found])
     reason[found] = ""
@@ -210,6 +213,13 @@ def _limit_chunk(b, f, S0, *, body, gains, ref, o, steps_per_period):
         crossings=runs.crossings, slides=runs.slides, t_sliding=runs.t_sliding, reason=reason,
         orbit=[orb["x"][q].copy() if found[q] else None for q in range(N)]))
     return frame, runs
+
+
+def _reference_turns(ref) -> int:
+    """Whole turns of the path's heading phi_d over one period: 1 on the circle (27) run forward
+    (-1 backward), 0 on the eight (28), whose tangent oscillates about pi."""
+    z0, z1 = ref.z(0.0), ref.z(ref.period)
+    return int(round((float(z1[2]) - float(z0[2])) / (2 * np.pi)))
 
 
 #: samples per reference period of the runs that measure ranges over a whole orbit or run
