@@ -68,6 +68,11 @@ def fig5_map(body: Body, n: int = FIG5_GRID["n"], *, confirm=("perturbed",), los
         columns of :func:`confirm_attractors` and :func:`confirm_lost`.
     """
     n = checks.integer("n", n, minimum=2)
+    checks.instance("body", body, Body)
+    for key in tuple(confirm):         # the options first, not after the sweep (issue 37)
+        checks.one_of("confirm", key, tuple(CONFIRMATIONS))
+    if lost_factor is not None:
+        checks.integer("lost_factor", lost_factor, minimum=2)
     R, Th = np.meshgrid(np.linspace(*FIG5_GRID["R"], n), np.linspace(*FIG5_GRID["Theta"], n))
     frame = eight_rotation_sweep(body, R.ravel(), Th.ravel(), executor=executor, chunk_size=chunk_size,
                                  progress=progress)

@@ -1,5 +1,6 @@
-"""limit_verdicts on the circle (27): the path's own heading turns once a period, and an orbit
-that follows it holds the heading (issue 37: it was counted as a slip)."""
+"""The library at its edges (issue 37): limit_verdicts on the circle (27), whose own heading
+turns once a period (an orbit that follows it was counted as a slip), and options checked before
+the work."""
 
 import math
 
@@ -32,3 +33,15 @@ def test_the_circle_is_periodic_and_held_at_the_closed_form_equilibrium():
     assert fr.floquet.to_numpy() == pytest.approx([want, want], abs=1e-4)
     # reason: the heading error is constant on the orbit, its range the integration's noise
     assert (fr.p_range < 1e-6).all()
+
+
+@pytest.mark.parametrize("kw, name", [({"confirm": ("bogus",)}, "confirm"), ({"lost_factor": 1}, "lost_factor"),
+                                      ({"body": "body"}, "body")])
+def test_fig5_map_checks_its_options_before_the_sweep(monkeypatch, kw, name):
+    # issue 37: a bad option was refused only after the 100 x 100 sweep (115 s)
+    from lib.rotation import fig5
+    monkeypatch.setattr(fig5, "eight_rotation_sweep", lambda *a, **k: pytest.fail("swept before checking"))
+    args = dict(body=BODY, n=100)
+    args.update(kw)
+    with pytest.raises((TypeError, ValueError), match=name):
+        fig5.fig5_map(args.pop("body"), **args)
