@@ -45,3 +45,17 @@ def test_fig5_map_checks_its_options_before_the_sweep(monkeypatch, kw, name):
     args.update(kw)
     with pytest.raises((TypeError, ValueError), match=name):
         fig5.fig5_map(args.pop("body"), **args)
+
+
+def test_a_steady_window_longer_than_the_run_is_refused():
+    # issue 37: a 100-period window over a 3-period run measured the whole run, start included
+    from lib.tracking.runs import run, steady_summary
+    res = run(BODY, GAINS, "eight", 2.0, math.pi / 4, 3)
+    with pytest.raises(ValueError, match="longer than the run"):
+        steady_summary(res, n_periods=100)
+    assert steady_summary(res, n_periods=3)["pos_err_max"] > 0.0     # reason: the whole run is allowed
+
+
+def test_a_bad_force_limit_is_named_with_its_value():
+    with pytest.raises(ValueError, match=r"-1"):
+        limit_verdicts(BODY, GAINS, trajectories.eight(), [1.0], -1.0)

@@ -87,7 +87,8 @@ def _limits_arrays(angle_limits, force_limits):
     if not np.all((b > 0) & (b <= np.pi)):
         raise ValueError(f"every angle limit must be in (0, pi] rad, got {b[~((b > 0) & (b <= np.pi))][:3]}")
     if np.any(np.isnan(f)) or not np.all(f > 0):
-        raise ValueError("every force limit must be positive (N) or inf for none")
+        bad = f[np.isnan(f) | ~(f > 0)]
+        raise ValueError(f"every force limit must be positive (N) or inf for none, got {bad[:3]}")
     return b.copy(), f.copy()
 
 

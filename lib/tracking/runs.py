@@ -92,6 +92,9 @@ def steady_mask(res: SimulationResult, n_periods: float) -> np.ndarray:
     """
     if n_periods <= 0:
         raise ValueError(f"n_periods must be positive, got {n_periods!r}")
+    if n_periods * res.ref.period > res.t[-1] - res.t[0] + 1e-9:
+        raise ValueError(f"n_periods = {n_periods!r} periods ({n_periods * res.ref.period:g} s) is longer than the run "
+                         f"({res.t[-1] - res.t[0]:g} s): the window would hold the transient from the start")
     return res.t >= res.t[-1] - n_periods * res.ref.period - 1e-9
 
 
