@@ -16,7 +16,7 @@ from .machinery import checks
 
 __all__ = ["Reference", "Circle", "Eight", "circle", "eight", "make", "NAMES", "circle_kinematics",
            "eight_kinematics", "KINEMATICS", "circle_position", "eight_position", "position_kinematics", "POSITIONS",
-           "eight_heading_fourier", "heading_series", "PAPER_HEADING_SERIES"]
+           "eight_heading_fourier", "heading_series", "PAPER_HEADING_SERIES", "heading_turns"]
 
 
 def _check_shape(R: float, theta: float) -> tuple[float, float]:
@@ -315,6 +315,24 @@ def eight(R: float = 2.0, theta: float = math.pi / 4) -> Eight:
 
 
 NAMES = {"circle": circle, "eight": eight}
+
+
+def heading_turns(ref: Reference) -> int:
+    """Whole turns of the path's heading phi_d over one period: 1 on the circle (27) run forward
+    (-1 backward), 0 on the eight (28), whose tangent oscillates about pi.
+
+    Parameters
+    ----------
+    ref : Reference
+        A path with ``z`` of t and ``period`` (s).
+
+    Returns
+    -------
+    int
+        The turns of phi_d per period.
+    """
+    z0, z1 = ref.z(0.0), ref.z(ref.period)
+    return int(round((float(z1[2]) - float(z0[2])) / (2 * math.pi)))
 
 
 def make(name: str, R: float, theta: float) -> Reference:

@@ -80,3 +80,11 @@ def test_batch_kinematics_equal_the_reference_objects_point_by_point():
             ref = T.make(name, R[j], theta[j])
             for k, method in enumerate((ref.z, ref.dz, ref.ddz)):
                 np.testing.assert_array_equal(batch[k][:, j], method(t[:, 0]))
+
+
+def test_heading_turns_counts_the_paths_heading_over_a_period():
+    # the circle's tangent turns once a period (backwards when run backwards), the eight's returns
+    from lib.trajectories import circle, eight, heading_turns
+    assert heading_turns(circle(2.0, 0.7)) == 1
+    assert heading_turns(circle(2.0, -0.7)) == -1
+    assert heading_turns(eight(2.0, 0.7)) == 0

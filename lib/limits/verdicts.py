@@ -29,7 +29,7 @@ from ..params import Body, Gains
 from ..dynamics.sampled import sampled_extremes, sampled_range
 from .runs import (STEPS_PER_PERIOD, SwitchedRuns, _check_parts, _concat_runs, _limits_arrays, _start_states,
                    error_state, switched_runs)
-from ..trajectories import Reference
+from ..trajectories import Reference, heading_turns
 
 __all__ = [
     "error_state", "stroboscopic_section", "Regime", "classify", "section_sweep", "sweep_angle_limit",
@@ -185,7 +185,7 @@ def _limit_chunk(b, f, S0, *, body, gains, ref, o, steps_per_period):
     found = orb["found"]
     # the turns against the path's heading: on the circle (27) phi_d itself turns once a period,
     # so an orbit that follows it gains k turns per k periods and still holds the heading
-    orb["n"] = np.where(found, orb["n"] - orb["k"] * _reference_turns(ref), orb["n"])
+    orb["n"] = np.where(found, orb["n"] - orb["k"] * heading_turns(ref), orb["n"])
     sec = runs.errors[:, ntr:]
     returns = dv.section_returns(np.moveaxis(sec, 0, 1), angles=(4,))
     regime, reason = dv.classify(lamT, seT, returns, band=o["lyapunov_band"], return_tol=o["return_tol"],
@@ -213,13 +213,6 @@ def _limit_chunk(b, f, S0, *, body, gains, ref, o, steps_per_period):
         crossings=runs.crossings, slides=runs.slides, t_sliding=runs.t_sliding, reason=reason,
         orbit=[orb["x"][q].copy() if found[q] else None for q in range(N)]))
     return frame, runs
-
-
-def _reference_turns(ref) -> int:
-    """Whole turns of the path's heading phi_d over one period: 1 on the circle (27) run forward
-    (-1 backward), 0 on the eight (28), whose tangent oscillates about pi."""
-    z0, z1 = ref.z(0.0), ref.z(ref.period)
-    return int(round((float(z1[2]) - float(z0[2])) / (2 * np.pi)))
 
 
 #: samples per reference period of the runs that measure ranges over a whole orbit or run

@@ -28,7 +28,7 @@ from ..limits.verdicts import limit_verdicts
 from ..machinery import checks
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from ..percussion.law import ANTI_WINDUP_TIME, closed_loop_rates, error_polynomial
-from ..trajectories import POSITIONS, make
+from ..trajectories import POSITIONS, heading_turns, make
 from .bound import cap_bound
 from .loop import FlowMap, loop_verdict, run_periods, steady_measures
 from .study import PAPER_CAP, SETTINGS, limit_motions, setting_label
@@ -137,8 +137,8 @@ def law_row(body: Body, gains: Gains, ref, law: str, limits: Limits, *, measure_
     """
     checks.one_of("law", law, LAWS[1:3])
     loop = law_loop(body, gains, ref, law, limits)
-    turns = 1 if ref.__class__.__name__ == "Circle" else 0
-    v = loop_verdict(loop.rates, ref.period, loop.s0, reference_turns=turns, steps=LAW_STEPS[law], **LAW_OPTIONS)
+    v = loop_verdict(loop.rates, ref.period, loop.s0, reference_turns=heading_turns(ref), steps=LAW_STEPS[law],
+                     **LAW_OPTIONS)
     if v.reason.startswith("diverged"):
         return dict(regime="undecided", reason=v.reason, floquet=np.nan, max_error=np.inf, rms_error=np.inf,
                     F_peak=np.nan, beta_peak=np.nan, p_range=np.nan)

@@ -34,7 +34,7 @@ from ..model import config_from_state, state_from_config
 from ..params import Body
 from ..percussion import paper_steady
 from ..simulate import simulate_open_loop
-from ..trajectories import POSITIONS, make
+from ..trajectories import POSITIONS, heading_turns, make
 from .collocation import ACCEPTED, tableau, transcription
 
 __all__ = ["PeriodicMotion", "periodic_motion", "verify_motion", "STARTS", "MAX_NODES", "FREE_ANGLE"]
@@ -344,7 +344,7 @@ def periodic_motion(body: Body, R: float, Theta: float, *, kind: str = "eight", 
     """
     R, Theta, F_max, beta_max, nodes, degree, guesses, starts = _check_args(
         body, R, Theta, kind, F_max, beta_max, nodes, degree, guess, starts)
-    turns = 1 if kind == "circle" else 0
+    turns = heading_turns(make(kind, R, Theta))
     T = 2 * np.pi / Theta
     h = T / nodes
     tab = tableau(degree)
