@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings, strategies as st
 
 from lib.integrators import batch
 
@@ -44,3 +45,25 @@ def test_recording_and_blow_up():
     with pytest.raises(FloatingPointError, match="non-finite at t = .* for point 1"), np.errstate(over="ignore",
                                                                                               invalid="ignore"):
         batch.integrate(lambda t, y: np.array([[0.0], [1.0]]) * y**2, np.ones((2, 1)), 0.0, 5.0, 0.05)
+
+
+@settings(max_examples=80, deadline=None)
+@given(t0=st.floats(-50.0, 50.0), length=st.floats(1e-3, 100.0), ratio=st.floats(0.5, 400.0))
+def test_the_step_never_exceeds_the_requested_dt_and_is_the_largest_that_divides_the_interval(t0, length, ratio):
+    # integrate's contract: the largest step h <= dt with n h = t_end - t0 (n = ceil((t_end - t0) / dt));
+    # a step count rounded down instead would take steps longer than the dt the caller asked for
+    dt, t_end = length / ratio, t0 + length
+    t, _ = batch.integrate(lambda t, y: -y, np.ones(1), t0, t_end, dt, batch.RK4)
+    n = len(t) - 1                                       # record_every = 1: one record a step
+    h = (t_end - t0) / n
+    eps = np.finfo(float).eps
+    assert h <= dt * (1 + 4 * eps)  # exact: h = L / ceil(fl(L / dt)) <= dt up to the rounding of two divisions
+    if n > 1:                                            # and one step fewer would exceed dt
+        assert (t_end - t0) / (n - 1) > dt * (1 - 4 * eps)  # exact: as above
+    # the recorded times advance by h (each t0 + k h, rounded)
+    np.testing.assert_allclose(np.diff(t), h, rtol=0, atol=8 * eps * max(abs(t0), abs(t_end), h))  # exact: t0 + k h rounded, a few ulp of |t|
+
+
+def test_an_interval_that_is_not_a_multiple_of_dt_takes_the_next_whole_count_of_steps():
+    t, _ = batch.integrate(lambda t, y: -y, np.ones(1), 0.0, 1.0, 0.3, batch.RK4)
+    np.testing.assert_allclose(t, [0.0, 0.25, 0.5, 0.75, 1.0], rtol=0, atol=1e-15)  # exact: sums of the step 1 / 4; measured 0

@@ -129,3 +129,18 @@ def test_a_slipping_orbit_is_lost_on_its_orbit_and_not_decided_again():
                               slip=[1.0], slip_stderr=[0.0], steps=[64], verdict_steps=[32], reason=[""]))
     c = confirm_lost(BODY, "eight", frame)
     assert bool(c.lost.iloc[0]) and c.lost_horizon.iloc[0] == 0
+
+
+def test_a_slipping_orbit_of_period_two_reached_late_is_the_same_orbit_when_decided_again(perturb):
+    # a point whose heading reaches, after the transient, an orbit of period 2 that slips two turns
+    # (one a period): decided again from the moved start it reaches the same orbit with the same
+    # turns, n = slip x period = 2 (the slip column counts turns a period), so the attractor is
+    # determined and the verdict stays slipping
+    p0 = float(perturb([0.0])[0])
+    frame = eight_rotation_sweep(BODY, [0.477273], [0.562626], p0=p0)
+    row = frame.iloc[0]
+    assert row.regime == "slipping" and row.period == 2 and row.slip * row.period == 2
+    assert row.periods > VERDICT_DEFAULTS["transient"]    # reached late: it is decided again
+    c = confirm_attractors(BODY, "eight", frame, x0=(p0, 0.0))
+    assert c.confirmed.iloc[0] == 1
+    assert c.regime.iloc[0] == "slipping" and c.period.iloc[0] == 2, c.reason.iloc[0]
