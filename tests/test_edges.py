@@ -1,38 +1,15 @@
-"""The library at its edges (issue 37): limit_verdicts on the circle (27), whose own heading
-turns once a period (an orbit that follows it was counted as a slip), and options checked before
-the work."""
+"""The library at its edges (issue 37): options checked before the work, windows and limits
+refused with their values. (limit_verdicts on the circle: tests/test_circle_verdicts.py.)"""
 
 import math
 
-import numpy as np
 import pytest
 
 from lib import trajectories
 from lib.limits.verdicts import limit_verdicts
 from lib.params import Body, Gains
-from lib.rotation.circle import circle_eigenvalues, circle_equilibria
 
 BODY, GAINS = Body(), Gains()
-
-
-def test_the_circle_is_periodic_and_held_at_the_closed_form_equilibrium():
-    # no angle limit (pi) and one the steady force never reaches (1 rad > beta* = 0.074 rad): the
-    # orbit is C on the circle with the heading at (33)'s stable equilibrium p0
-    fr, _ = limit_verdicts(BODY, GAINS, trajectories.circle(), [np.pi, 1.0])
-    assert list(fr.regime) == ["periodic", "periodic"] and list(fr.turns) == [0, 0]
-    assert not fr.lost.any() and (fr.drift == 0).all()
-    p0 = circle_equilibria(BODY, 2.0, math.pi / 4)[0]
-    for orbit in fr.orbit:
-        # accuracy: Newton's tolerance 1e-9 on the switched map, times 100
-        assert math.remainder(orbit[2] - math.pi / 2 - p0, 2 * math.pi) == pytest.approx(0.0, abs=1e-7)
-    # the largest multiplier is the heading's pair of (35), exp(Re(lambda) T), above the position
-    # error's exp(-Kv T / (2 m)) of (24)
-    T = trajectories.circle().period
-    want = float(np.exp(circle_eigenvalues(BODY, 2.0, math.pi / 4).real.max() * T))
-    # accuracy: a forward-difference Jacobian of step 1e-6 on a map integrated to 1e-10, ~1e-5
-    assert fr.floquet.to_numpy() == pytest.approx([want, want], abs=1e-4)
-    # reason: the heading error is constant on the orbit, its range the integration's noise
-    assert (fr.p_range < 1e-6).all()
 
 
 @pytest.mark.parametrize("kw, name", [({"confirm": ("bogus",)}, "confirm"), ({"lost_factor": 1}, "lost_factor"),
