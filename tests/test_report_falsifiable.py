@@ -250,6 +250,28 @@ def test_percussion_map_row_fails_with_one_point_not_held(monkeypatch, regime, l
     assert _status(monkeypatch, "percussion-map", cached=_cache(percussion_fig5_map=fr)) == status
 
 
+@pytest.mark.parametrize("lost, not_held, undecided, status", [
+    (36, 277, 0, "extended"), (36, 277, 50, "extended"),
+    (0, 277, 0, "not reproducible"),            # the heading lost nowhere
+    (36, 1000, 0, "not reproducible"),          # nothing held
+    (36, 277, 51, "not reproducible"),          # more than 5 % undecided
+])
+def test_fig5_map_row_needs_a_map_partly_lost_and_decided(monkeypatch, lost, not_held, undecided, status):
+    n = 1000
+    regime = np.array(["periodic"] * n, dtype=object)
+    regime[:not_held] = "chaotic"
+    regime[not_held - undecided:not_held] = "undecided"
+    fr = pd.DataFrame({"regime": regime, "lost": np.arange(n) < lost, "turns_round": np.arange(n) < 300})
+    assert _status(monkeypatch, "fig5-map", cached=_cache(fig5_map=fr)) == status
+
+
+def test_fig5_readings_count_each_reading_from_its_own_column():
+    fr = pd.DataFrame({"regime": ["periodic", "periodic", "slipping", "chaotic", "undecided"],
+                       "lost": [False, False, True, False, False], "turns_round": [False, True, True, True, False]})
+    assert ext.fig5_readings(fr) == {"grid": 5, "lost": 1, "turns_round": 3, "not_held": 3, "held": 2,
+                                     "undecided": 1}
+
+
 # ------------------------------------------------------------------ Chapter 8's rows
 
 _SETTINGS = [(None, 4.0), (30, None), (30, 4.0)]
@@ -314,5 +336,5 @@ def test_optimal_tracker_row_fails_with_each_clause(monkeypatch, kw, status):
 
 def test_every_extension_row_has_a_falsifying_test():
     tested = {"limit-lyapunov", "limit-mirror", "wrong-model", "slow-eights", "window", "weight-limit",
-              "percussion-circle", "percussion-map", "cap-bound", "angle-optimum", "optimal-tracker"}
+              "percussion-circle", "percussion-map", "cap-bound", "angle-optimum", "optimal-tracker", "fig5-map"}
     assert set(ITEMS) == tested

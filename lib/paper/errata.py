@@ -8,8 +8,9 @@ without its check.
 
 Rows are grouped by the paper's sections in :mod:`.model_errata` (Secs. 2-3),
 :mod:`.tracking_errata` (Secs. 4-5), :mod:`.rotation_errata` (Sec. 6) and
-:mod:`.reading_errata` (slips of notation and definitions found by a line-by-line
-audit, with two that change a computation: (24) and (28)), each
+:mod:`.reading_errata` (slips of notation, readings and definitions found by a
+line-by-line audit: the branch of Arg in (28) and the rows in which (24) holds change no
+computation of the paper's and are flagged ``notation``), each
 importing the domain modules whose computations prove its rows; no domain
 module imports this subpackage.
 """
@@ -55,11 +56,24 @@ def _check_row(key: str) -> Verdict:
 
 
 def table(run_checks: bool = True):
-    """The errata as a pandas DataFrame; with ``run_checks`` each row's verdict is computed."""
+    """The errata as a pandas DataFrame; with ``run_checks`` each row's verdict is computed.
+
+    Parameters
+    ----------
+    run_checks : bool
+        Run each row's check (columns ``confirmed`` and ``detail``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row an erratum; ``kind`` says whether it changes a result or is a slip of notation
+        or a reading that changes no computation (``Erratum.notation``).
+    """
     records = []
     for r in rows():
         rec = {"key": r.key, "where": r.where, "printed": r.printed, "corrected": r.corrected,
-               "verified by": r.verified_by, "section": r.section}
+               "verified by": r.verified_by, "section": r.section,
+               "kind": "notation or reading" if r.notation else "changes a result"}
         if run_checks:
             v = verdict(r.key)
             rec["confirmed"] = v.confirmed

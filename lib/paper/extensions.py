@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pandas as pd
 
 from ..machinery.cache import cached
 from ..rotation.circle import circle_critical_radius, circle_equilibria
@@ -33,7 +34,7 @@ from ..trajectories import eight
 from ..weighting.circle import circle_steady_state, circle_weight_limit
 from .outcomes import Item, Outcome, legend_status
 
-__all__ = ["items"]
+__all__ = ["items", "fig5_readings", "mirror_attractors"]
 
 #: the paper's rate and radius (its Table; Chapter 3's choice for the eight)
 R0, THETA0 = 2.0, math.pi / 4
@@ -52,6 +53,41 @@ def _check_window() -> Outcome:
                    f"located as a homoclinic connection (shooting); the window closes below Theta = {th:.4f} "
                    "rad/s, where the normalised damping is the damped pendulum's classical threshold "
                    f"(agreement {gap:.1e}); 'globally asymptotically stable' holds only outside the window")
+
+
+def fig5_readings(frame: pd.DataFrame) -> dict[str, int]:
+    """Three readings of Fig. 5's "loss of stability" on a map of verdicts, as counts of points.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        A Fig. 5 map (:func:`lib.rotation.fig5.fig5_map`): columns ``regime``, ``lost``, ``turns_round``.
+
+    Returns
+    -------
+    dict
+        ``grid`` (points), ``lost`` (the heading slips: a slipping orbit, or a net drift by more
+        than three standard errors), ``turns_round`` (the heading error ranges over more than a
+        full turn), ``not_held`` (no attracting periodic orbit without slip: not
+        :func:`lib.dynamics.verdicts.held`), ``held`` and ``undecided``.
+    """
+    kept = held(frame.regime, frame.lost)
+    return {"grid": len(frame), "lost": int(frame.lost.sum()), "turns_round": int(frame.turns_round.sum()),
+            "not_held": int((~kept).sum()), "held": int(kept.sum()),
+            "undecided": int((frame.regime == "undecided").sum())}
+
+
+def _check_fig5_map() -> Outcome:
+    # Chapter 5's map (computed once per book build and shared with the chapter)
+    r = fig5_readings(cached(fig5_map, Body()))
+    n = r["grid"]
+    ok = r["lost"] > 0 and r["not_held"] < n and r["undecided"] <= 0.05 * n
+    return Outcome(legend_status(ok, extension=True), r["not_held"] / n,
+                   f"share of Chapter 5's {n}-point map where the heading is not held (no attracting periodic "
+                   "orbit without slip; at most 5 % undecided)",
+                   f"each point decided (periodic orbits with Floquet multipliers, Lyapunov exponents, drift); "
+                   f"not held at {r['not_held']} points, the heading lost (slips) at {r['lost']} of them, and "
+                   f"turning round (ranging over more than a turn) at {r['turns_round']}")
 
 
 def _check_weighted_circle() -> Outcome:
@@ -105,14 +141,31 @@ def _chapter4_eight():
     return eight(R0, THETA0), np.concatenate([PAPER_Z0, PAPER_DZ0])
 
 
-def _check_mirror() -> Outcome:
+def mirror_attractors() -> tuple[pd.DataFrame, float]:
+    """Chapter 4's attractors of the eight at a 90 deg angle limit without a cap, from its 12
+    heading offsets and the mirrored start (its call, read through the build's cache).
+
+    Returns
+    -------
+    frame : pandas.DataFrame
+        :func:`lib.limits.attractors.start_attractors`'s frame: the 12 offsets from -180 deg by
+        30 deg (offset 0, the paper's start, at row 6), then the mirrored start.
+    angle_limit : float
+        The angle limit (rad).
+    """
     body, gains = Body(), Gains()
     ref, s0 = _chapter4_eight()
     b = math.radians(90)
     offsets = np.radians(np.arange(-180, 180, 30))      # Chapter 4's starts
     starts = np.vstack([heading_offset_starts(offsets), mirrored_start(body, gains, ref, b, None, s0)])
-    frame = cached(start_attractors, body, gains, ref, b, None, starts)
-    paper, mirror = frame.iloc[int(np.flatnonzero(offsets == 0)[0])], frame.iloc[-1]
+    return cached(start_attractors, body, gains, ref, b, None, starts), b
+
+
+def _check_mirror() -> Outcome:
+    body, gains = Body(), Gains()
+    ref, s0 = _chapter4_eight()
+    frame, b = mirror_attractors()
+    paper, mirror = frame.iloc[6], frame.iloc[-1]
     defect = float(np.max(mirror_defect(body, gains, ref, b, None, s0, 4)))
     asymmetric = paper.symmetric is not None and not bool(paper.symmetric)
     ok = paper.attractor == "A" and asymmetric and paper.mirror_gap > 1.0 and mirror.attractor == "A'" \
@@ -231,6 +284,8 @@ def items() -> list[Item]:
           "chapters/04_limits", "extended", _check_lyapunov),
         I("window", "Sec. 6, extended: the circle's bistable window, located exactly",
           "chapters/05_stability", "extended", _check_window),
+        I("fig5-map", "Fig. 5, extended: every point of the map decided, three readings counted",
+          "chapters/05_stability", "extended", _check_fig5_map),
         I("slow-eights", "Sec. 6, extended: slow eights by the overdamped heading (37 'cannot be simplified')",
           "chapters/05_stability", "extended", _check_slow_eights),
         I("weight-limit", "Sec. 4 open problem, extended: the weighted law on the circle, its exact limit",

@@ -13,19 +13,26 @@ import numpy as np
 
 __all__ = ["STATUSES", "Outcome", "Item", "legend_status"]
 
-STATUSES = ("reproduced", "corrected", "refuted", "not reproducible", "extended")
+STATUSES = ("reproduced", "reproduced under an added condition", "corrected", "misapplied", "refuted",
+            "not reproducible as stated", "not reproducible", "extended")
 
 
 @dataclass(frozen=True)
 class Outcome:
     """Result of a report check: the status, a figure of merit with its label, a note, the
-    errata row it links, and whether the check found a counterexample to the paper's claim."""
+    errata row it links, and what the check established beside its evidence (the flags of
+    :func:`legend_status`): a counterexample to the claim as the paper uses it, a theorem used
+    outside its hypotheses, a condition the paper does not state that the confirmation needs,
+    or a figure whose grid and criterion the paper does not state and that depends on them."""
     status: str
     merit: float
     merit_label: str
     note: str = ""
     erratum: str | None = None
     counterexample: bool = False
+    misapplied: bool = False
+    added_condition: bool = False
+    unstated: bool = False
 
     def __post_init__(self) -> None:
         if self.status not in STATUSES:
@@ -45,16 +52,26 @@ class Item:
 
 
 def legend_status(evidence: bool, *, printed_fails: bool = False, counterexample: bool = False,
-                  extension: bool = False) -> str:
+                  extension: bool = False, misapplied: bool = False, added_condition: bool = False,
+                  unstated: bool = False) -> str:
     """The report's legend as one rule: the status of a row from what its check established.
+
+    In this order:
 
     - ``evidence`` False (the computation does not confirm the row): **not reproducible**;
     - ``extension`` (the book goes beyond the paper): **extended**;
+    - ``unstated`` (the paper leaves out what a reproduction needs, a grid or a criterion, and
+      the check shows that the result depends on it): **not reproducible as stated**; the
+      book's own answer is an extension row;
+    - ``misapplied`` (a true theorem cited for a system outside its hypotheses, the check
+      showing a hypothesis fails): **misapplied**, not "refuted": the theorem stands;
     - ``counterexample`` (a case where the paper's claim, as printed and as it is used, is
-      false: a bistable window against "globally", a system with drift against a theorem
-      for systems without one): **refuted**, however much of it survives;
+      false: a bistable window against "globally", a two-state system against Theorem 6):
+      **refuted**, however much of it survives;
     - ``printed_fails`` (an errata row on the row's equations, not a slip of notation only,
       confirms that the printed form fails and the corrected one holds): **corrected**;
+    - ``added_condition`` (confirmed only with something the paper does not state, such as a
+      force cap beside the angle limit): **reproduced under an added condition**;
     - else: **reproduced**, the paper's statement holds as printed.
 
     Parameters
@@ -67,6 +84,12 @@ def legend_status(evidence: bool, *, printed_fails: bool = False, counterexample
         The check exhibits a counterexample to the claim.
     extension : bool
         The row is one of the book's extensions.
+    misapplied : bool
+        The claim cites a theorem whose hypotheses the paper's system does not meet.
+    added_condition : bool
+        The confirmation needs a condition the paper does not state.
+    unstated : bool
+        The paper does not state what a reproduction needs, and the result depends on it.
 
     Returns
     -------
@@ -77,6 +100,12 @@ def legend_status(evidence: bool, *, printed_fails: bool = False, counterexample
         return "not reproducible"
     if extension:
         return "extended"
+    if unstated:
+        return "not reproducible as stated"
+    if misapplied:
+        return "misapplied"
     if counterexample:
         return "refuted"
-    return "corrected" if printed_fails else "reproduced"
+    if printed_fails:
+        return "corrected"
+    return "reproduced under an added condition" if added_condition else "reproduced"

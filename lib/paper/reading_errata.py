@@ -207,30 +207,33 @@ def _errata():
             key="eq24-rows",
             where="Sec. 4, (24), as Sec. 5 uses it with (25)-(26)",
             printed=r"substituting (23) into (22) leads to $M\ddot e + K_v\dot e + K_p e = 0$ (24), "
-                    r"$e = z_d - z$, which 'proves exponential convergence of the errors to zero'. The paper "
-                    r"derives it for $Q = \tau$, at once raises the problem of representing $\tau$ by $Q$, "
-                    r"drops the rotation control in (25)-(26), and in Sec. 5 cites (24) for the loop with "
-                    r"(23), (25)-(26) to prove (29)-(30), expecting only a constant rotation error (31); "
-                    r"which rows of (24) hold under (25)-(26) it does not say",
-            corrected=r"under (23) with (25)-(26) the $x$ and $y$ rows of (24) hold exactly "
-                      r"($Q_x = \tau_x$, $Q_y = \tau_y$), so (29)-(30) follow; the $\varphi$ row does not "
-                      r"($Q_\varphi = Fa\sin\beta \ne \tau_\varphi$): the rotation error obeys (32)",
+                    r"$e = z_d - z$, which 'proves exponential convergence of the errors to zero'; derived for "
+                    r"$Q = \tau$, then cited in Sec. 5 for the loop with (23), (25)-(26) to prove (29)-(30). "
+                    r"Read as holding in every row under (25)-(26), it fails",
+            corrected=r"a reading, not an error: under (23) with (25)-(26) the $x$ and $y$ rows of (24) hold "
+                      r"exactly ($Q_x = \tau_x$, $Q_y = \tau_y$), which is all (29)-(30) use; the $\varphi$ row "
+                      r"does not ($Q_\varphi = Fa\sin\beta \ne \tau_\varphi$), as the paper expects with (31): "
+                      r"the rotation error obeys (32). No printed form fails",
             verified_by="the circle simulated 20 s against (24)'s solution, row by row "
                         "(`lib.paper.reading_errata._check_eq24_rows`)",
             section="chapters/03_tracking",
             check=_check_eq24_rows,
             equations=(24,),
+            notation=True,
         ),
         Erratum(
             key="eq28-arg-branch",
             where="Sec. 4, (28), the eight's heading",
             printed=r"$\mathrm{Arg}(\cos 2\theta t + \sqrt{-1}\cos\theta t)$, principal value",
-            corrected=r"the same angle on its continuous branch (it jumps by $2\pi$ as printed)",
+            corrected=r"the same angle on its continuous branch (as printed it jumps by $2\pi$). A slip of "
+                      r"notation: both name the tangent direction, and the law (25)-(26) never reads "
+                      r"$\varphi_d$, so no trajectory changes; a range of $p$ is taken on the continuous branch",
             verified_by="tangent angle and largest jump over two periods "
                         "(`lib.paper.reading_errata._check_arg_branch`)",
             section="chapters/03_tracking",
             check=_check_arg_branch,
             equations=(28,),
+            notation=True,
         ),
         Erratum(
             key="theta-symbol",

@@ -7,16 +7,14 @@ report page renders the outcomes; the test suite runs every check and asserts
 that the computed status is the one the book reports (``Item.expected``), so a
 regression changes the page and fails the tests.
 
-Statuses: ``reproduced`` (the paper's statement holds as printed),
-``corrected`` (it holds after the correction recorded in the errata row
-``erratum``), ``refuted`` (false as printed, shown by a counterexample; the
-errata row gives the true, weaker statement), ``not reproducible`` (as stated it
-cannot be confirmed; the note says why), ``extended`` (the book goes beyond the
-paper). The legend is one rule, :func:`lib.paper.outcomes.legend_status`: a row with a
-confirmed errata row on its equations (:func:`errata_on`; a slip of notation only does not
-count) is not "reproduced" but "corrected"; a claim with a counterexample is "refuted". A
-check decides between the status the legend gives its item and ``not reproducible``; the
-test suite asserts that it decides the claimed one and that the claimed one is the legend's.
+The statuses (:data:`STATUSES`) and the rule that gives them are
+:func:`lib.paper.outcomes.legend_status`: a confirmed errata row on a row's equations
+(:func:`errata_on`; a slip of notation only does not count) makes it "corrected"; a
+counterexample "refuted", a theorem cited outside its hypotheses "misapplied"; a confirmation
+that needs a condition the paper does not state "reproduced under an added condition"; a
+figure whose unstated grid or criterion decides it "not reproducible as stated". A check
+decides between the status the legend gives its item and ``not reproducible``; the test suite
+asserts that it decides the claimed one and that the claimed one is the legend's.
 """
 
 from __future__ import annotations
@@ -40,9 +38,8 @@ from ..limits.torus import NS_ANGLE_DEG, NS_START_CAP, torus_birth
 from ..limits.verdicts import extend_undecided, limit_verdicts
 from ..model import f, generalized_force
 from ..params import Body, Gains
-from ..rotation.attractor import map_summary, rotation_attractor
+from ..rotation.attractor import rotation_attractor
 from ..rotation.fig5 import fig5_map
-from ..rotation.verdicts import FIG5_GRID
 from ..rotation.equations import derive_rotation_equation
 from ..simulate import OPEN_LOOP_HORIZON, Integration, open_loop_comparison, simulate
 from ..symbolic import derive_body_frame, rank_determinants
@@ -50,7 +47,7 @@ from ..tracking.runs import run, steady_summary
 from ..trajectories import circle, eight, eight_heading_fourier
 from ..machinery.cache import cached
 from .errata import rows, verdict
-from .extensions import items as extension_items
+from .extensions import fig5_readings, items as extension_items
 from .outcomes import STATUSES, Item, Outcome, legend_status
 
 __all__ = ["Outcome", "Item", "items", "outcome", "table", "STATUSES", "equation_numbers", "errata_on"]
@@ -125,10 +122,10 @@ def _check_eq24() -> Outcome:
     res = _circle_run()
     exact = error_dynamics_solution(Body(), Gains(), res.error[0], res.derror[0], res.t)
     dev = float(np.abs(res.error[:, :2] - exact[:, :2]).max())
-    return _corrected_by("eq24-rows", dev, "max |e_sim - e_(24)| on x, y (m), circle, 60 s",
-                         "(24) is derived for Q = tau; with (25)-(26) its x and y rows hold exactly, its phi row "
-                         "does not (the rotation obeys (32)): which rows hold the paper leaves unsaid",
-                         evidence=dev < 1e-8)
+    return Outcome(legend_status(dev < 1e-8), dev, "max |e_sim - e_(24)| on x, y (m), circle, 60 s",
+                   "(24) is derived for Q = tau and holds; with (25)-(26) its x and y rows hold exactly, which "
+                   "is all (29)-(30) use; its phi row does not (the rotation obeys (32)), and the paper expects "
+                   "only (31) there. No printed form fails")
 
 
 def _check_allocation() -> Outcome:
@@ -205,10 +202,12 @@ def _check_thm6() -> Outcome:
 
 def _check_thm7() -> Outcome:
     drift = float(np.linalg.norm(f(Body(), np.array([0.0, 0.0, 0.3, 1.0, 0.5, 0.2]))))
-    return _refuted_by("thm7-drift", drift, "|f(q)| at a moving state: the drift is not zero",
-                       "misapplied: Theorem 7 is for systems without drift; the conclusion of Sec. 3 cites it for "
-                       "(5), which has one, and with a drift accessibility implies no controllability "
-                       "(counterexample in the errata row)", evidence=drift > 0)
+    v = verdict("thm7-drift")
+    return Outcome(legend_status(drift > 0 and v.confirmed, counterexample=True, misapplied=True), drift,
+                   "|f(q)| at a moving state: the drift is not zero",
+                   "Theorem 7 (Chow) is true, for systems without drift; the conclusion of Sec. 3 cites it for "
+                   "(5), which has one, and with a drift accessibility implies no controllability "
+                   "(counterexample in the errata row)", erratum="thm7-drift", counterexample=True, misapplied=True)
 
 
 def _check_conclusion() -> Outcome:
@@ -232,9 +231,11 @@ def _check_eq27_28() -> Outcome:
         z, dz = ref.z(t), ref.dz(t)
         tangent = np.arctan2(dz[:, 1], dz[:, 0])
         dev = max(dev, float(np.abs(np.angle(np.exp(1j * (z[:, 2] - tangent)))).max()))
-    return _corrected_by("eq28-arg-branch", dev, "max |phi_d - tangent angle| (rad), both paths",
-                         "the eight's heading holds on its continuous branch; the printed principal Arg jumps "
-                         "by 2 pi", evidence=dev < 1e-12)
+    verdict("eq28-arg-branch")      # the linked row's check runs (a slip of notation: it counts for nothing)
+    return Outcome(legend_status(dev < 1e-12), dev, "max |phi_d - tangent angle| (rad), both paths",
+                   "the printed principal Arg names the tangent direction modulo 2 pi and jumps by 2 pi; the law "
+                   "(25)-(26) never reads phi_d, so no trajectory changes: a slip of notation (errata row)",
+                   erratum="eq28-arg-branch")
 
 
 def _check_eq31() -> Outcome:
@@ -322,14 +323,15 @@ def _check_quasi() -> Outcome:
     born = (ns.modulus_below < 1.0 < ns.modulus_above and ns.multiplier.imag > 0.1
             and abs(ns.circle_rotation - ns.rotation) < ns.circles[0].rotation_error
             and ns.force_limit < NS_START_CAP)
-    return Outcome(legend_status(bool(with_cap and born)), ns.force_limit,
+    return Outcome(legend_status(n_alone > 0 or bool(with_cap and born), added_condition=n_alone == 0), ns.force_limit,
                    f"force cap (N) where the period-1 orbit's complex pair of multipliers crosses the unit circle, "
                    f"angle limit {NS_ANGLE_DEG:g} deg (brentq, xtol {ns.xtol:g} N)",
-                   f"with a force cap added to the angle limit (whether one applies the paper does not say; "
-                   f"{n_alone} of the {len(free)} angle limits without a cap are quasi-periodic): at "
+                   f"only with a force cap added to the angle limit, which the paper never mentions ({n_alone} "
+                   f"of the {len(free)} angle limits without a cap are quasi-periodic): at "
                    f"{NS_ANGLE_DEG:g} deg the orbit loses stability at {ns.force_limit:.4f} N (Neimark-Sacker, "
                    f"|mu| {ns.modulus_below:.5f} and {ns.modulus_above:.5f} either side), and a torus is born "
-                   f"turning by {ns.rotation:.4f} turns a period; quasi-periodic at {NS_START_CAP:g} N (Chapter 4)")
+                   f"turning by {ns.rotation:.4f} turns a period; quasi-periodic at {NS_START_CAP:g} N (Chapter 4)",
+                   added_condition=n_alone == 0)
 
 
 # ------------------------------------------------------------------ Sec. 6
@@ -404,18 +406,18 @@ def _check_fourier() -> Outcome:
 
 
 def _check_fig5() -> Outcome:
-    # the chapter's own map (computed once per book build and shared with Chapter 5)
-    frame = cached(fig5_map, Body())
-    m = map_summary(frame)
-    lost = m.n_lost / m.n_grid
-    n = FIG5_GRID["n"]
-    return Outcome(legend_status(0.0 < lost < 1.0 and m.n_undecided <= 0.05 * m.n_grid, extension=True), lost,
-                   f"fraction of Chapter 5's {n} x {n} map where the heading is lost (it slips); at most 5 % undecided",
-                   f"each point decided (periodic orbits with Floquet multipliers, Lyapunov exponents, drift); "
-                   f"the heading turns round (the other reading) at a fraction {m.n_turns_round / m.n_grid:.3f}; "
-                   f"chaotic at {m.n_chaotic / m.n_grid:.3f}, transient chaos (attractor not determined: a start "
-                   f"moved by 1e-12 or a longer run reaches another attractor) at {m.n_transient / m.n_grid:.4f}; "
-                   "the paper's grid and criterion are not stated")
+    # the chapter's own map (computed once per book build and shared with Chapter 5), read three ways
+    r = fig5_readings(cached(fig5_map, Body()))
+    marked = (r["lost"], r["turns_round"], r["not_held"])
+    spread = max(marked) / max(min(marked), 1)
+    decided = min(marked) > 0 and max(marked) < r["grid"] and r["undecided"] <= 0.05 * r["grid"]
+    return Outcome(legend_status(decided, unstated=spread > 2.0), spread,
+                   "largest / smallest count of points marked on Chapter 5's map over three readings of "
+                   "'loss of stability' (lost, turns round, not held)",
+                   f"the paper states neither its grid nor its criterion, and the marked set depends on the "
+                   f"criterion: of {r['grid']} points the heading is lost (slips) at {r['lost']}, turns round at "
+                   f"{r['turns_round']}, is not held at {r['not_held']}; the book's map is the row 'Fig. 5, "
+                   f"extended'", unstated=spread > 2.0)
 
 
 def items() -> list[Item]:
@@ -434,16 +436,16 @@ def items() -> list[Item]:
           "corrected", _check_count),
         I("thm6", "Theorem 6: accessibility implies STLC", "chapters/02_controllability", "refuted", _check_thm6),
         I("thm7", "Theorem 7 as used in the conclusion of Sec. 3", "chapters/02_controllability",
-          "refuted", _check_thm7),
+          "misapplied", _check_thm7),
         I("stlc", "Sec. 3 conclusion: STLC off the exceptional set", "chapters/02_controllability", "refuted",
           _check_conclusion),
         I("eq23-24", "Eqs. (23)-(24): computed torque and the error equation", "chapters/03_tracking",
-          "corrected", _check_eq24),
+          "reproduced", _check_eq24),
         I("eq25-26", "Eqs. (25)-(26): position-only allocation", "chapters/03_tracking", "reproduced",
           _check_allocation),
         I("sec4-open", "Sec. 4: the allocation min ||tau - Q||^2 (left unsolved)", "chapters/06_allocation",
           "extended", _check_open_problem),
-        I("eq27-28", "Eqs. (27)-(28): circle and eight references", "chapters/03_tracking", "corrected",
+        I("eq27-28", "Eqs. (27)-(28): circle and eight references", "chapters/03_tracking", "reproduced",
           _check_eq27_28),
         I("eq29-30", "Eqs. (29)-(30): position errors vanish", "chapters/03_tracking", "reproduced",
           _check_limits_29_30),
@@ -456,7 +458,7 @@ def items() -> list[Item]:
         I("chaos", "Sec. 5: an angle limit may cause chaotic errors", "chapters/04_limits", "reproduced",
           _check_chaos),
         I("quasi", "Sec. 5: an angle limit may cause quasi-periodic errors", "chapters/04_limits",
-          "reproduced", _check_quasi),
+          "reproduced under an added condition", _check_quasi),
         I("eq32", "Eq. (32): rotation on the reference", "chapters/05_stability", "reproduced", _check_eq32),
         I("eq33", "Eq. (33): rotation error on the circle", "chapters/05_stability", "corrected", _check_eq33),
         I("p0", "Sec. 6: equilibria p0 and their existence", "chapters/05_stability", "corrected", _check_p0),
@@ -468,7 +470,8 @@ def items() -> list[Item]:
         I("eq37", "Eq. (37): rotation on the eight", "chapters/05_stability", "corrected", _check_eq37),
         I("fourier", "Sec. 6: 3-term series of the eight's tangent angle", "chapters/05_stability", "corrected",
           _check_fourier),
-        I("fig5", "Fig. 5: rotation-error range over (R, Theta)", "chapters/05_stability", "extended", _check_fig5),
+        I("fig5", "Fig. 5: rotation-error range over (R, Theta)", "chapters/05_stability",
+          "not reproducible as stated", _check_fig5),
     ] + extension_items()
 
 

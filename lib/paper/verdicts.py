@@ -32,8 +32,9 @@ class Erratum:
     ``printed`` and ``corrected`` are MyST/LaTeX snippets (inline math in $...$);
     ``verified_by`` names the test or the computation; ``section`` the book page
     (a document path such as ``chapters/01_model``) that shows it. ``notation``: a slip of
-    notation or numbering that changes no computation; such a row does not make the report
-    row of its equations "corrected" (:func:`lib.paper.outcomes.legend_status`).
+    notation or numbering, or a reading the paper leaves open, that changes no computation of
+    the paper's; such a row does not make the report row of its equations "corrected"
+    (:func:`lib.paper.outcomes.legend_status`).
     ``equations``: the numbers of the paper's equations whose printed form the row corrects
     (none for a claim, a definition or a theorem without a number).
     """
