@@ -1,19 +1,97 @@
 """What the book found, for its front page (``intro.md``): each finding a report row
 (:mod:`lib.paper.report`), its status and its figure of merit, read through
 :func:`lib.paper.report.outcome`, so the front page quotes the computation the report and the
-chapters show, computed once per book build."""
+chapters show, computed once per book build.
+
+Every number the front page states is one of :func:`front_page`'s, and each carries a unit
+and a reading in :data:`LABELS`: what it counts or measures, and in what (a count is of
+points, angle limits or runs; a distance in m, an angle in rad). The same holds for the
+numbers of each chapter's findings box. ``tests/test_findings_labels.py`` checks that the page
+writes each number beside its unit and its reading.
+"""
 
 from __future__ import annotations
 
-from .report import outcome
+import math
 
-__all__ = ["FINDINGS", "findings"]
+import numpy as np
+
+from ..limits.attractors import half_period_mirror
+from ..machinery.cache import cached
+from ..optimal.compare import limits_study
+from ..optimal.study import PAPER_CAP
+from ..params import Body, Gains
+from ..percussion import percussion_fig5_map
+from ..rotation.circle_global import bistable_window
+from ..rotation.fig5 import fig5_map
+from ..simulate import OPEN_LOOP_HORIZON, open_loop_comparison
+from ..trajectories import eight
+from .extensions import R0, THETA0, fig5_readings, mirror_attractors
+from .report import SWEEP_DEG, _angle_sweep, outcome
+
+__all__ = ["FINDINGS", "LABELS", "findings", "front_page"]
 
 #: the report rows the front page states, each with the status it states
 FINDINGS = {
-    "eq6": "corrected", "thm6": "refuted", "stlc": "refuted", "gas": "refuted", "window": "extended",
-    "fig3": "reproduced", "limit-mirror": "extended", "chaos": "reproduced", "fig5": "extended",
+    "eq6": "corrected", "thm6": "refuted", "thm7": "misapplied", "stlc": "refuted", "gas": "refuted",
+    "window": "extended", "fig3": "reproduced", "limit-mirror": "extended", "chaos": "reproduced",
+    "quasi": "reproduced under an added condition", "fig5": "not reproducible as stated", "fig5-map": "extended",
     "weight-limit": "extended", "percussion-map": "extended", "cap-bound": "extended",
+}
+
+#: for each page, the numbers its findings box glues: name -> (unit, reading). The unit is written
+#: within a few words of the number (before it for "row 2"), the reading in the same bullet; a
+#: unit "" marks a pure number (a weight, a multiplier), whose reading says what it is
+LABELS = {
+    "intro": {
+        "fd_eq6_t": ("s", "inputs"), "fd_eq6_pos": ("m", "centre of mass"), "fd_eq6_heading": ("rad", "heading"),
+        "fd_fig3": ("rad", "ranging"), "fd_mirror_heading": ("rad", "heading"),
+        "fd_mirror_rate": ("rad/s", "turning rate"), "fd_mirror_pos": ("m", "centres of mass"),
+        "fd_chaos": ("1/s", "Lyapunov exponent"), "fd_chaos_n": ("angle limits", "chaotic"),
+        "fd_chaos_cap_n": ("angle limits", "cap"), "fd_angles": ("angle limits", "chaotic"),
+        "fd_window_lo": ("m", "window"), "fd_window_hi": ("m", "window"),
+        "fd_grid": ("points", "grid"), "fd_not_held": ("points", "not held"), "fd_lost": ("points", "lost"),
+        "fd_turns": ("points", "turns round"), "fd_weight": ("", "weight"),
+        "fd_p_held": ("points", "law for P"), "fd_p_grid": ("points", "held"),
+        "fd_paper_held": ("points", "paper's law"), "fd_bound": ("m", "lower bound"),
+        "fd_paper_cap": ("m", "paper's law"),
+    },
+    "chapters/01_model": {
+        "n_wrong_rows": ("row", "drift"), "wrong_row": ("row", "wrong sign"),
+        "ol_gap_end": ("m", "centre of mass"), "ol_t_end": ("s", "after"),
+    },
+    "chapters/02_controllability": {"n_wrong": ("entries", "wrong"), "n_entries": ("entries", "printed")},
+    "chapters/03_tracking": {
+        "orb_range_deg": ("degrees", "range"), "orb_mu1": ("", "Floquet multiplier"),
+        "mm_circle_m20": ("m", "position error"), "mm_eight_m20": ("m", "position error"),
+    },
+    "chapters/04_limits": {
+        "free_n_chaotic": ("angle limits", "chaotic"), "bif_n": ("angle limits", "chaotic"),
+        "free_min_z": ("standard errors", "chaotic"), "capsw_n_chaotic": ("angle limits", "cap"),
+        "qp_total": ("runs", "quasi-periodic"), "qp_with_cap": ("runs", "force cap"),
+    },
+    "chapters/05_stability": {
+        "win_rcrit": ("m", "slipping"), "win_redge": ("m", "slipping"), "f5_n_grid": ("points", "Fig. 5"),
+        "f5_n_periodic": ("points", "periodic"), "f5_n_lost": ("points", "lost"),
+        "f5_n_turns_round": ("points", "turns round"), "f5_not_held": ("points", "not held"),
+    },
+    "chapters/06_allocation": {
+        "wc_lim": ("", "w_\\varphi"), "wc_lim_kind": ("", "loses stability"),
+        "x_not_held_held": ("points", "holds"), "x_not_held_total": ("points", "does not hold"),
+        "x_held_failed": ("points", "fails"), "x_held_total": ("points", "does"),
+    },
+    "chapters/07_percussion": {
+        "s_P": ("m", "from C"), "eps": ("m/s", "drag"), "lock": ("m", "locks"), "crit": ("m", "(36)"),
+        "rate": ("1/s", "rate"), "n_held": ("points", "held"), "n_grid": ("points", "grid"),
+        "n_lost": ("points", "lost"), "n_chaotic": ("points", "chaotic"),
+    },
+    "chapters/08_optimal": {
+        "b4_max": ("m", "lower bound"), "b4_max_ach": ("m", "motion"), "p4_max": ("m", "paper's law"),
+        "p4_ratio": ("times", "least possible"), "m30c_rms": ("m", "RMS"), "paper30c_rms": ("m", "RMS"),
+        "paper30c_ratio": ("times", "as much"), "opt_periodic": ("settings", "periodic orbit"),
+        "opt_n": ("settings", "periodic orbit"), "opt_paper_reached": ("settings", "paper's start"),
+        "map_ratio_median": ("times", "median"), "map_FP_max": ("N", "peak force"),
+    },
 }
 
 
@@ -35,4 +113,53 @@ def findings() -> dict[str, float]:
         o = outcome(key)
         assert o.status == status, (key, o.status, status)
         out[key] = o.merit
+    return out
+
+
+def _open_loop_gap() -> tuple[float, float]:
+    """Distance (m) of the printed drift's centre of mass from the true one, and their headings'
+    difference (rad), at the end of Chapter 1's open-loop run."""
+    _, runs = open_loop_comparison(Body(), OPEN_LOOP_HORIZON)
+    d = runs["printed"][-1] - runs["config"][-1]
+    return float(math.hypot(d[0], d[1])), float(abs(np.angle(np.exp(1j * d[2]))))
+
+
+def _mirror_gap() -> np.ndarray:
+    """The paper's attractor at a 90 deg angle limit against its mirror image at the same phase:
+    |difference| of x, y (m), phi (rad, modulo 2 pi), their rates (m/s, rad/s)."""
+    frame, b = mirror_attractors()
+    orbit = np.asarray(frame.iloc[6].orbit, dtype=float)
+    d = half_period_mirror(Body(), Gains(), eight(R0, THETA0), b, None, orbit)[0] - orbit
+    d[2] = np.angle(np.exp(1j * d[2]))
+    return np.abs(d)
+
+
+def front_page() -> dict[str, float]:
+    """Every number of the front page's findings, by glue name (the keys of ``LABELS["intro"]``).
+
+    Returns
+    -------
+    dict
+        glue name -> value, in the unit :data:`LABELS` gives it.
+    """
+    f = findings()
+    pos, heading = _open_loop_gap()
+    gap = _mirror_gap()
+    free, capped = _angle_sweep(None), _angle_sweep(PAPER_CAP)
+    lo, hi = cached(bistable_window, Body(), THETA0)                       # Chapter 5's call
+    paper, p_law = fig5_readings(cached(fig5_map, Body())), fig5_readings(cached(percussion_fig5_map, Body()))
+    table = cached(limits_study, Body(), Gains(), R0, THETA0)["table"]           # Chapter 8's call
+    paper_cap = table[(table.law == "paper") & (table.cap == PAPER_CAP) & table.angle_deg.isna()]
+    out = {
+        "fd_eq6_t": OPEN_LOOP_HORIZON, "fd_eq6_pos": pos, "fd_eq6_heading": heading, "fd_fig3": f["fig3"],
+        "fd_mirror_heading": gap[2], "fd_mirror_rate": gap[5], "fd_mirror_pos": float(math.hypot(gap[0], gap[1])),
+        "fd_chaos": f["chaos"], "fd_chaos_n": int((free.regime == "chaotic").sum()),
+        "fd_chaos_cap_n": int((capped.regime == "chaotic").sum()), "fd_angles": len(SWEEP_DEG),
+        "fd_window_lo": lo, "fd_window_hi": hi,
+        "fd_grid": paper["grid"], "fd_not_held": paper["not_held"], "fd_lost": paper["lost"],
+        "fd_turns": paper["turns_round"], "fd_paper_held": paper["held"], "fd_weight": f["weight-limit"],
+        "fd_p_held": p_law["held"], "fd_p_grid": p_law["grid"], "fd_bound": f["cap-bound"],
+        "fd_paper_cap": float(paper_cap.max_error.iloc[0]),
+    }
+    assert set(out) == set(LABELS["intro"]), set(out) ^ set(LABELS["intro"])
     return out
