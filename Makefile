@@ -62,6 +62,7 @@ test-portable: $(STAMP)
 
 benchmark: $(STAMP)
 	$(BIN)/python benchmarks/bench_switched.py
+	$(BIN)/python benchmarks/bench_locators.py
 	$(BIN)/python benchmarks/bench_eight_sweep.py
 	$(BIN)/python benchmarks/bench_scale.py
 	$(BIN)/python benchmarks/bench_book.py

@@ -80,11 +80,12 @@ def copy_book(dest: Path, root: Path = ROOT) -> None:
         shutil.copy2(root / f"{page}.md", dest / f"{page}.md")
 
 
-def run_page(md: Path, timeout: int = 900) -> dict:
-    """Execute one page in its folder; its wall and CPU time and every code cell's."""
+def run_page(md: Path, timeout: int = 900, setup: str = "") -> dict:
+    """Execute one page in its folder; its wall and CPU time and every code cell's. ``setup``:
+    code run first in the kernel, not timed as a cell (a benchmark's variant)."""
     nb = jupytext.read(md)
     code = [c for c in nb.cells if c.cell_type == "code"]
-    nb.cells.insert(0, nbformat.v4.new_code_cell(_SETUP))
+    nb.cells.insert(0, nbformat.v4.new_code_cell(_SETUP + "\n" + setup))
     nb.cells.append(nbformat.v4.new_code_cell(_REPORT))
     client = NotebookClient(nb, timeout=timeout, kernel_name="python3",
                             resources={"metadata": {"path": str(md.parent)}})

@@ -15,9 +15,9 @@ from ..machinery import checks
 from ..angles import wrap_angle
 from ..integrators.batch import dop853
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
-from ..trajectories import Circle, Eight, Reference
+from ..trajectories import KINEMATICS, Circle, Eight, Reference
 
-__all__ = ["error_state", "SwitchedRuns", "switched_runs", "STEPS_PER_PERIOD"]
+__all__ = ["error_state", "SwitchedRuns", "switched_runs", "STEPS_PER_PERIOD", "LOCATORS"]
 
 def error_state(ref: Reference, t, y) -> np.ndarray:
     """Tracking errors of states ``y`` (n, 6) at times ``t``: columns
@@ -54,7 +54,8 @@ class SwitchedRuns:
     (``t`` (n S + 1,), s; S samples per period, by default one), the error states there (``errors``, see :func:`error_state`),
     the final modes, ``log_growth`` (N, n_lyap) the companion's log(d / d0) over each
     period from ``lyapunov_from`` on, and the crossings of S, slides and time sliding (s)
-    of each run."""
+    of each run; ``locating`` (N, 3): its events, the real steps spent locating them and the
+    dense estimates handed on to the bracket locator (:mod:`lib.integrators.switched_events`)."""
 
     angle_limit: np.ndarray
     force_limit: np.ndarray
@@ -68,10 +69,14 @@ class SwitchedRuns:
     crossings: np.ndarray
     slides: np.ndarray
     t_sliding: np.ndarray
+    locating: np.ndarray
 
 
 #: steps of the compiled integrator per reference period (8th-order Dormand-Prince)
 STEPS_PER_PERIOD = 200
+#: how the compiled integrator locates events: on the step's dense output, then one real step
+#: (the default), or by real steps only (:mod:`lib.integrators.switched_events`)
+LOCATORS = ("dense", "bracket")
 
 
 def _limits_arrays(angle_limits, force_limits):
@@ -97,6 +102,8 @@ def _check_parts(body, gains, ref) -> None:
     checks.instance("body", body, Body)
     checks.instance("gains", gains, Gains)
     checks.instance("ref", ref, (Circle, Eight), "lib.trajectories.Circle or Eight")
+    checks.loop_domain(body, gains, KINEMATICS["circle" if isinstance(ref, Circle) else "eight"], [ref.R],
+                       [ref.theta], heading_gains=False)      # the domain before any run (issue 37)
 
 
 def _start_states(s0, n: int) -> np.ndarray:
@@ -120,7 +127,8 @@ def _concat_runs(parts: list) -> SwitchedRuns:
 
 def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_limits=None, *, s0=None,
                   n_periods: int, lyapunov_from: int | None = None, steps_per_period: int = STEPS_PER_PERIOD,
-                  samples_per_period: int = 1, d0: float = 1e-7, k_slide: float = 5.0) -> SwitchedRuns:
+                  samples_per_period: int = 1, d0: float = 1e-7, k_slide: float = 5.0,
+                  locator: str = "dense") -> SwitchedRuns:
     """Run the closed loop (2)-(4), (23), (25)-(26) with |beta| <= ``angle_limits`` (rad;
     pi for no angle limit) and F <= ``force_limits`` (N; None or inf for no cap), one run
     per pair, for ``n_periods`` reference periods from the states ``s0`` ((6,) or (N, 6);
@@ -161,6 +169,9 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
         The companion's initial separation, in (0, 1e-3).
     k_slide : float
         The sliding exits' gain.
+    locator : {"dense", "bracket"}
+        How events are located (:data:`LOCATORS`): on the step's 7th-order dense output,
+        then one real step, or by real steps only; both to 1e-11 s.
 
     Returns
     -------
@@ -168,7 +179,7 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
         The limits, the sample times, the recorded states and errors, the final modes, the
     companion's log-growths and the event statistics (crossings, slides, time sliding).
     """
-    from ..integrators.switched_compiled import run_periods  # numba compiles on first use: only when asked
+    from ..integrators.switched_compiled import dop853_dense, run_periods  # numba compiles on first use
 
     _check_parts(body, gains, ref)
     b, f = _limits_arrays(angle_limits, force_limits)
@@ -185,6 +196,7 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
         raise ValueError("the Lyapunov companion needs samples_per_period = 1")
     if not checks.number("d0", d0, positive=True) < 1e-3:
         raise ValueError(f"d0 must be in (0, 1e-3), got {d0!r}")
+    locator = checks.one_of("locator", locator, LOCATORS)
     S0 = _start_states(s0, b.size)
     g = gains
     P = np.array([body.m, body.I, body.a, body.c, body.c_phi, g.kp[0], g.kp[1], g.kv[0], g.kv[1], ref.R, ref.theta,
@@ -194,7 +206,8 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
     # with S samples per period the kernel's "period" is T / S: the reference is T-periodic,
     # the kernel only needs the sampling interval and the steps within it
     states, modes, logs, stats = run_periods(P, b, f, S0, int(n_periods) * S, int(steps_per_period) // S, T / S,
-                                             0.0, lf, float(d0), tab.A, tab.b / tab.b_den, tab.c)
+                                             0.0, lf, float(d0), tab.A, tab.b / tab.b_den, tab.c,
+                                             dense_output=dop853_dense() if locator == "dense" else None)
     bad = np.flatnonzero(stats[:, 4] != 0)
     if bad.size:
         q = int(bad[0])
@@ -205,4 +218,5 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
     err = error_state(ref, np.tile(t, b.size), states.reshape(-1, 6)).reshape(states.shape)
     return SwitchedRuns(angle_limit=b, force_limit=f, period=T, t=t, states=states, errors=err, mode_end=modes,
                         log_growth=logs, lyapunov_from=lf, crossings=stats[:, 0].astype(int),
-                        slides=stats[:, 1].astype(int), t_sliding=stats[:, 2])
+                        slides=stats[:, 1].astype(int), t_sliding=stats[:, 2],
+                        locating=stats[:, [3, 5, 6]].astype(int))

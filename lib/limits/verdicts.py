@@ -27,7 +27,7 @@ from ..machinery.parallel import map_chunks
 from .sections import Regime, classify, section_sweep, stroboscopic_section, sweep_angle_limit  # re-exported
 from ..params import Body, Gains
 from ..dynamics.sampled import sampled_extremes, sampled_range
-from .runs import (STEPS_PER_PERIOD, SwitchedRuns, _check_parts, _concat_runs, _limits_arrays, _start_states,
+from .runs import (LOCATORS, STEPS_PER_PERIOD, SwitchedRuns, _check_parts, _concat_runs, _limits_arrays, _start_states,
                    error_state, switched_runs)
 from ..trajectories import Reference, heading_turns
 
@@ -61,23 +61,24 @@ class _SwitchedMap:
 
     turn_axis = 2
 
-    def __init__(self, body, gains, ref, b, f, steps_per_period):
+    def __init__(self, body, gains, ref, b, f, steps_per_period, locator="dense"):
         self.body, self.gains, self.ref, self.b, self.f, self.steps = body, gains, ref, b, f, steps_per_period
+        self.locator = locator
 
     def advance(self, idx, x, k):
         k = np.unique(np.asarray(k, dtype=int))
         if k.size != 1:
             raise ValueError("the switched runs of one call share their number of periods")
         return switched_runs(self.body, self.gains, self.ref, self.b[idx], self.f[idx], s0=x, n_periods=int(k[0]),
-                             steps_per_period=self.steps).states[:, -1]
+                             steps_per_period=self.steps, locator=self.locator).states[:, -1]
 
     def step(self, idx, x, k, h):
         return dv.difference_jacobian(self, idx, x, k, h)
 
 
 def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force_limits=None, *, s0=None,
-                   steps_per_period: int = STEPS_PER_PERIOD, executor=None, chunk_size: int | None = None,
-                   progress: bool | None = None, **options):
+                   steps_per_period: int = STEPS_PER_PERIOD, locator: str = "dense", executor=None,
+                   chunk_size: int | None = None, progress: bool | None = None, **options):
     """Decide the long-run regime of the switched closed loop for each (angle limit (rad),
     force limit (N)) pair by the book's one decision procedure (:mod:`lib.dynamics.verdicts`)
     on the full state. Options (:data:`LIMIT_DEFAULTS`): ``transient`` periods dropped,
@@ -135,6 +136,8 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
         default the paper's Table.
     steps_per_period : int
         Fixed steps per reference period of the compiled integrator (>= 16).
+    locator : {"dense", "bracket"}
+        How the compiled integrator locates events (:mod:`lib.integrators.switched_events`).
     executor : concurrent.futures.Executor, optional
         Where the chunks of pairs run (a process pool, a dask ``Client.get_executor()``).
     chunk_size : int, optional
@@ -157,23 +160,24 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
         raise ValueError(f"periods ({npr}) must cover two blocks ({blk}) and twice max_period ({kmax})")
     _check_parts(body, gains, ref)
     steps_per_period = checks.integer("steps_per_period", steps_per_period, minimum=16)
+    locator = checks.one_of("locator", locator, LOCATORS)
     b, f = _limits_arrays(angle_limits, force_limits)
     S0 = _start_states(s0, b.size)
     parts = map_chunks(_limit_chunk, b.size, (b, f, S0), dict(body=body, gains=gains, ref=ref, o=o,
-                                                             steps_per_period=steps_per_period),
+                                                             steps_per_period=steps_per_period, locator=locator),
                        executor, chunk_size, progress)
     if len(parts) == 1:
         return parts[0]
     return pd.concat([p[0] for p in parts], ignore_index=True), _concat_runs([p[1] for p in parts])
 
 
-def _limit_chunk(b, f, S0, *, body, gains, ref, o, steps_per_period):
+def _limit_chunk(b, f, S0, *, body, gains, ref, o, steps_per_period, locator):
     """(frame, runs) of :func:`limit_verdicts` for validated pairs (one chunk of them)."""
     ntr, npr, blk, kmax = o["transient"], o["periods"], o["block"], o["max_period"]
     runs = switched_runs(body, gains, ref, b, f, s0=S0, n_periods=ntr + npr,
-                         lyapunov_from=ntr, steps_per_period=steps_per_period)
+                         lyapunov_from=ntr, steps_per_period=steps_per_period, locator=locator)
     T, N = runs.period, runs.states.shape[0]
-    pmap = _SwitchedMap(body, gains, ref, runs.angle_limit, runs.force_limit, steps_per_period)
+    pmap = _SwitchedMap(body, gains, ref, runs.angle_limit, runs.force_limit, steps_per_period, locator)
     step = lambda i, x, k: pmap.step(i, x, k, o["fd_step"])  # noqa: E731
     lamT, seT = dv.block_statistics(runs.log_growth, blk)
     hist = np.moveaxis(runs.states[:, ntr:], 0, 1).copy()
@@ -238,7 +242,7 @@ def _over_the_run(pmap: "_SwitchedMap", start, orb: dict, periods: int, block: i
         if rows.size == 0:
             continue
         r = switched_runs(pmap.body, pmap.gains, pmap.ref, pmap.b[rows], pmap.f[rows], s0=x0[rows], n_periods=k,
-                          steps_per_period=pmap.steps, samples_per_period=S)
+                          steps_per_period=pmap.steps, samples_per_period=S, locator=pmap.locator)
         p = r.states[:, :, 2] - pmap.ref.z(r.t)[:, 2][None]
         err = r.errors
         e = np.hypot(err[..., 0], err[..., 1])
