@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 import pandas as pd
+from scipy import stats
 
 from ..machinery.cache import cached
 from ..rotation.circle import circle_critical_radius, circle_equilibria
@@ -21,20 +22,21 @@ from ..rotation.circle_global import bistable_window, torque_pendulum_threshold,
 from ..limits.attractors import (heading_offset_starts, lyapunov_horizons, mirror_defect, mirrored_start,
                                  start_attractors)
 from ..tracking.mismatch import mismatch_study
-from ..dynamics.verdicts import held
+from ..dynamics.verdicts import ORBIT_REGIMES, SIGMAS, held
 from ..percussion import (centre_of_percussion, circle_lock_radius, circle_steady_motion,
                           percussion_fig5_map)
 from ..optimal.compare import limits_study
 from ..optimal.motion import verify_motion
 from ..optimal.study import PAPER_CAP
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
-from ..rotation.fig5 import fig5_map
+from ..rotation.fig5 import LOST_FACTOR, fig5_map
+from ..rotation.verdicts import VERDICT_DEFAULTS
 from ..rotation.slow_eight import slow_eight_prediction
 from ..trajectories import eight
 from ..weighting.circle import circle_steady_state, circle_weight_limit
 from .outcomes import Item, Outcome, legend_status
 
-__all__ = ["items", "fig5_readings", "mirror_attractors"]
+__all__ = ["items", "fig5_readings", "mirror_attractors", "lost_false_positives"]
 
 #: the paper's rate and radius (its Table; Chapter 3's choice for the eight)
 R0, THETA0 = 2.0, math.pi / 4
@@ -77,9 +79,43 @@ def fig5_readings(frame: pd.DataFrame) -> dict[str, int]:
             "undecided": int((frame.regime == "undecided").sum())}
 
 
+def lost_false_positives(frame: pd.DataFrame) -> tuple[int, float]:
+    """How many of a Fig. 5 map's "lost" verdicts the drift test could give by chance: the
+    points it decided (no orbit reached), and the expected number of them it would call lost if
+    none drifted at all, an upper bound.
+
+    A heading without an orbit is lost when its drift differs from zero by more than
+    :data:`lib.dynamics.verdicts.SIGMAS` standard errors (plus a band) over a run of h periods,
+    and again over ``LOST_FACTOR`` h (:func:`lib.rotation.fig5.confirm_lost`); the standard
+    error comes from the means of blocks of ``block`` periods. With independent, normal block
+    means and no drift, the longer run's statistic is Student's t with (blocks - 1) degrees of
+    freedom, so a point is called lost with probability at most 2 P(T > SIGMAS); summed over
+    the points decided by the test.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        A map of :func:`lib.rotation.fig5.fig5_map` with its default options (columns
+        ``regime``, ``periods``).
+
+    Returns
+    -------
+    tested : int
+        Points decided by the drift test.
+    expected : float
+        Upper bound on the expected number of them called lost with no drift.
+    """
+    opts = VERDICT_DEFAULTS
+    no_orbit = ~frame.regime.isin(ORBIT_REGIMES).to_numpy()
+    h = frame.periods.to_numpy()[no_orbit] - opts["transient"]            # the first Lyapunov run
+    dof = np.maximum(LOST_FACTOR * h // opts["block"] - 1, 1)
+    return int(no_orbit.sum()), float(np.sum(2 * stats.t.sf(SIGMAS, dof)))
+
+
 def _check_fig5_map() -> Outcome:
     # Chapter 5's map (computed once per book build and shared with the chapter)
-    r = fig5_readings(cached(fig5_map, Body()))
+    frame = cached(fig5_map, Body())
+    r, (tested, chance) = fig5_readings(frame), lost_false_positives(frame)
     n = r["grid"]
     ok = r["lost"] > 0 and r["not_held"] < n and r["undecided"] <= 0.05 * n
     return Outcome(legend_status(ok, extension=True), r["not_held"] / n,
@@ -87,7 +123,9 @@ def _check_fig5_map() -> Outcome:
                    "orbit without slip; at most 5 % undecided)",
                    f"each point decided (periodic orbits with Floquet multipliers, Lyapunov exponents, drift); "
                    f"not held at {r['not_held']} points, the heading lost (slips) at {r['lost']} of them, and "
-                   f"turning round (ranging over more than a turn) at {r['turns_round']}")
+                   f"turning round (ranging over more than a turn) at {r['turns_round']}; the drift test "
+                   f"decided {tested} points and would call at most {chance:.1f} of them lost on average were none "
+                   f"to drift, so the lost count is a lower bound with few false positives")
 
 
 def _check_weighted_circle() -> Outcome:
