@@ -247,7 +247,9 @@ def test_percussion_circle_row_fails_with_each_clause(monkeypatch, radius_gap, l
 ])
 def test_percussion_map_row_fails_with_one_point_not_held(monkeypatch, regime, lost, status):
     fr = pd.DataFrame({"regime": ["periodic"] * 9 + [regime], "lost": [False] * 9 + [lost]})
-    assert _status(monkeypatch, "percussion-map", cached=_cache(percussion_fig5_map=fr)) == status
+    paper = pd.DataFrame({"regime": ["periodic"] * 7 + ["chaotic"] * 3, "lost": False, "turns_round": False})
+    got = _status(monkeypatch, "percussion-map", cached=_cache(percussion_fig5_map=fr, fig5_map=paper))
+    assert got == status
 
 
 @pytest.mark.parametrize("lost, not_held, undecided, status", [
