@@ -209,7 +209,8 @@ def _check_mirror() -> Outcome:
     ok = paper.attractor == "A" and asymmetric and paper.mirror_gap > 1.0 and mirror.attractor == "A'" \
         and defect < 1e-9                                                        # measured 2.56, 3e-14
     return Outcome(legend_status(bool(ok), extension=True), float(paper.mirror_gap),
-                   "distance from the paper's attractor at a 90 deg limit to its mirror image",
+                   "Hausdorff distance, max-norm over the state (m, rad, m/s and rad/s alike), from the paper's "
+                   "attractor at a 90 deg limit to its mirror image (the front page splits it by coordinate)",
                    "the closed loop under the limits is symmetric under the reflection with half a period "
                    f"(a run and its mirror agree to {defect:.0e}); the paper's start reaches an orbit that is "
                    "not its own mirror, and the mirrored start reaches the mirror orbit")
