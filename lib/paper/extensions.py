@@ -244,7 +244,8 @@ def _check_percussion_circle() -> Outcome:
     return Outcome(legend_status(ok, extension=True), st.rate,
                    "the heading's rate (1/s) on the circle with P on the paper's P-circle, Chapter 7",
                    f"closed form; given the circle P runs under the paper's law, C's closed-form circle is the "
-                   f"paper's R (agreement {gap:.1e}); the lock radius lies below the paper's (36)")
+                   f"paper's R (agreement {gap:.1e}); for the Table's body the lock radius lies below the "
+                   "paper's (36) (checked for this body only)")
 
 
 def _check_percussion_map() -> Outcome:
