@@ -111,3 +111,15 @@ def test_each_word_of_the_legend_names_the_rows_the_referee_named():
     assert by_key["fig5"].expected == "not reproducible as stated"          # grid and criterion unstated
     assert by_key["fig5-map"].expected == "extended"                        # and the book's map beside it
     assert {i.expected for i in ITEMS} == set(STATUSES) - {"not reproducible"}
+
+
+def test_the_errata_rows_say_what_the_report_rows_say():
+    """The errata agree with the report's words: Theorem 7's row calls it misapplied, and the rows
+    behind the reproduced (23)-(24) and (27)-(28) say that they change no computation."""
+    by_key = {r.key: r for r in errata.rows()}
+    assert by_key["thm7-drift"].corrected.startswith("misapplied") and not by_key["thm7-drift"].notation
+    assert "No printed form fails" in by_key["eq24-rows"].corrected
+    assert "slip of notation" in by_key["eq28-arg-branch"].corrected
+    kinds = errata.table(run_checks=False).set_index("key")["kind"]
+    assert kinds["eq24-rows"] == kinds["eq28-arg-branch"] == "notation or reading"
+    assert kinds["thm7-drift"] == "changes a result"
