@@ -25,7 +25,7 @@ from .integrators.smooth import Integration, SimulationError, integrate
 from .integrators.switched import SwitchedLoop
 from .model import config_accel, config_from_state, state_from_config, state_rhs
 from .params import PAPER_DZ0, PAPER_Z0, Body, Gains
-from .trajectories import Reference
+from .trajectories import Circle, Eight, Reference
 
 __all__ = ["SimulationError", "SimulationResult", "simulate", "Integration", "simulate_open_loop",
            "open_loop_comparison", "OPEN_LOOP_FORMS", "DEFAULT_RTOL", "DEFAULT_ATOL"]
@@ -96,24 +96,37 @@ def _instance(name: str, value, cls):
 
 #: explicit methods of :func:`scipy.integrate.solve_ivp` (their step is bounded by stability)
 EXPLICIT_METHODS = ("RK23", "RK45", "DOP853")
-#: the largest Lambda t_end allowed for an explicit run, Lambda (1/s) the closed loop's fastest
-#: rate and t_end the time span. An explicit method needs at least about Lambda t_end / 4 steps
-#: (its stability region reaches about 4 along the negative real axis), so this allows about
-#: 2.5e6 steps, minutes of CPU in Python
-MAX_STIFFNESS = 1e7
 
 
-def _check_stiffness(body: Body, gains: Gains, t_end: float, integration) -> None:
-    """Refuse an explicit run that stiffness would make last for hours (a tiny mass or inertia,
-    huge gains), naming the rate and the fix."""
+def _path_extremes(ref) -> tuple[float, float]:
+    """The largest speed (m/s) and acceleration (m/s^2) of the book's circle or eight over one
+    period, sampled at 257 times: what the reference makes the heading's stiffness (32). A
+    reference of the caller's own making gives (0, 0): its run is bounded by the gains' budget
+    and watched for blow-ups as it goes."""
+    if not isinstance(ref, (Circle, Eight)):
+        return 0.0, 0.0
+    t = np.linspace(0.0, ref.period, 257)
+    dz, ddz = np.asarray(ref.dz(t), float), np.asarray(ref.ddz(t), float)
+    return float(np.hypot(dz[:, 0], dz[:, 1]).max()), float(np.hypot(ddz[:, 0], ddz[:, 1]).max())
+
+
+def _check_budget(body: Body, gains: Gains, ref, t_end: float, integration, allocation) -> None:
+    """Refuse an explicit run whose fastest mode (the gains', or the heading's driven by the path,
+    :func:`lib.machinery.domain.loop_modes`) would make it take more than
+    :data:`lib.machinery.domain.MAX_RUN_STEPS` steps, naming the argument and the fix."""
+    if isinstance(ref, (Circle, Eight)):         # the book's paths: the heading's domain, as every sweep's
+        checks.heading_damping(body, ref.theta, "ref.theta")
     if integration.method not in EXPLICIT_METHODS:
         return
-    M, N = body.mass_matrix.diagonal(), body.drag
-    rate = float(np.max((gains.kv + N) / M + np.sqrt(gains.kp / M)))
-    if rate * t_end > MAX_STIFFNESS:
-        raise ValueError(f"the closed loop's fastest rate, about {rate:.3g} 1/s (from m, I_C, the drag and the gains), "
-                         f"makes {integration.method} over t_end = {t_end:g} s need about {rate * t_end / 4:.2g} steps "
-                         f"(more than {MAX_STIFFNESS / 4:.2g}); use a stiff method, integration=Integration(method='Radau'), or a shorter t_end")
+    speed, accel = _path_extremes(ref)
+    modes = checks.loop_modes(body, gains, speed=speed, accel=accel, heading_gains=allocation.law != "position")
+    named = {"ref": f"ref (R = {ref.R:g} m, theta = {ref.theta:g} rad/s)"} if isinstance(ref, (Circle, Eight)) else {}
+    need = {named.get(name, name): checks.run_steps(mode, t_end) for name, mode in modes.items()}
+    rate = max(abs(m) for m in modes.values())
+    checks.within_budget(need, checks.MAX_RUN_STEPS, what="the run would need",
+                         unit=f"steps of {integration.method} over t_end = {t_end:g} s (the closed loop's fastest "
+                         f"rate, about {rate:.3g} 1/s)",
+                         fix="use a stiff method, integration=Integration(method='Radau'), or a shorter t_end")
 
 
 def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz0=None, *,
@@ -188,12 +201,12 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
     integration = _instance("integration", integration, Integration)
     if model is not None:
         checks.instance("model", model, Body, "lib.params.Body or None")
-    _check_stiffness(body, gains, t_end, integration)
     if t_eval is None:
         t_eval = np.linspace(0.0, t_end, int(round(t_end * DEFAULT_RATE)) + 1)
     t_eval = checks.array("t_eval", t_eval)
     if t_eval.ndim != 1 or t_eval.size == 0 or t_eval[0] < 0 or t_eval[-1] > t_end or np.any(np.diff(t_eval) <= 0):
         raise ValueError("t_eval must be a non-empty increasing 1-D array within [0, t_end]")
+    _check_budget(body, gains, ref, t_end, integration, allocation)
     if integration.switching == "events":
         if model is not None and model != body:
             raise ValueError("switching='events' runs the plant's own model; give model=None")

@@ -109,7 +109,7 @@ def test_the_full_closed_loop_holds_c_on_the_circle_and_the_heading_at_the_equil
 
 
 def test_the_law_for_p_holds_the_circle_at_its_closed_form_steady_motion():
-    df = percussion.rotation_sweep(BODY, list(HELD), [TH, TH], kind="circle", steps=512)
+    df = percussion.heading_sweep(BODY, list(HELD), [TH, TH], kind="circle", steps=512)
     assert list(df.regime) == ["periodic", "periodic"] and not df.lost.any()
     for R, row in zip(HELD, df.itertuples()):
         m = zero_dynamics.circle_steady_motion(BODY, R, TH)

@@ -85,7 +85,7 @@ def test_peak_force_of_P_on_the_eight_tops_the_steady_samples_and_an_independent
     assert F_P > sm.F.max()
     # an independent route: the zero dynamics by adaptive DOP853 from the verdict's orbit point,
     # two periods to settle, then 2^16 samples of the third
-    v = pc.rotation_sweep(BODY, [R0], [TH0], kind="eight")
+    v = pc.heading_sweep(BODY, [R0], [TH0], kind="eight")
     ref = tr.eight(R0, TH0)
     T = ref.period
     t = np.concatenate([[0.0], 2 * T + np.arange(2**16) * T / 2**16])
@@ -120,7 +120,7 @@ def test_P_below_the_circle_lock_radius_is_NaN_and_the_frame_changes_nothing_els
     assert 0.1 < pc.circle_lock_radius(BODY, 0.05)
     got = dm.exact_force_map(BODY, R, Th, kind="circle", point="P")
     assert np.isnan(got[0]) and np.isfinite(got[1])
-    frame = pc.rotation_sweep(BODY, R, Th, kind="circle")
+    frame = pc.heading_sweep(BODY, R, Th, kind="circle")
     again = dm.exact_force_map(BODY, R, Th, kind="circle", point="P", frame=frame)
     np.testing.assert_array_equal(got, again)  # exact: the same verdicts, one code path
 
@@ -148,9 +148,9 @@ def test_peak_search_refines_every_local_maximum_candidate():
     (lambda: dm.exact_force_map(BODY, 1.0, 0.5, point="P", frame="frame"), "frame"),
     (lambda: dm.exact_force_map(BODY, 1.0, 0.5, point="P", frame=pd.DataFrame({"R": [1.0]})), "frame"),
     (lambda: dm.exact_force_map(BODY, [1.0, 2.0], 0.5, point="P",
-                                frame=pc.rotation_sweep(BODY, [1.0], [0.5])), "frame"),
+                                frame=pc.heading_sweep(BODY, [1.0], [0.5])), "frame"),
     (lambda: dm.exact_force_map(BODY, 1.0, 0.5, point="P",
-                                frame=pc.rotation_sweep(BODY, [1.5], [0.5])), "frame"),
+                                frame=pc.heading_sweep(BODY, [1.5], [0.5])), "frame"),
     (lambda: dm.exact_force_maps(BODY, 1), "n"),
     (lambda: dm.exact_force_maps(BODY, 2.0), "n"),
     (lambda: dm.exact_force_maps(None), "body"),

@@ -12,14 +12,14 @@ BODY = Body()
 
 
 def test_sweep_has_the_columns_of_the_papers_fig5_sweep():
-    ours = pc.rotation_sweep(BODY, [2.0], [0.5])
+    ours = pc.heading_sweep(BODY, [2.0], [0.5])
     theirs = stability.eight_rotation_sweep(BODY, [2.0], [0.5], engine="numpy", steps=64, max_periods=20)
     assert list(ours.columns) == list(theirs.columns)
 
 
 def test_orbit_point_is_where_the_adaptive_zero_dynamics_settle():
     R, Th = 1.5, 0.6
-    v = pc.rotation_sweep(BODY, [R], [Th], steps=1024)
+    v = pc.heading_sweep(BODY, [R], [Th], steps=1024)
     assert v.regime[0] == "periodic" and v.period[0] == 1 and not v.lost[0]
     ref = tr.eight(R, Th)
     T = ref.period
@@ -44,7 +44,7 @@ def test_magnus_map_converges_at_fourth_order():
 def test_below_the_lock_radius_the_circle_heading_is_lost_at_the_closed_form_drift():
     Th = 0.5
     R = 0.6 * pc.circle_lock_radius(BODY, Th)
-    v = pc.rotation_sweep(BODY, [R], [Th], kind="circle", steps=256)
+    v = pc.heading_sweep(BODY, [R], [Th], kind="circle", steps=256)
     assert bool(v.lost[0])
     assert v.regime[0] != "chaotic"
     # slip measured over the Lyapunov run (batch means) or exact on an orbit
@@ -61,8 +61,8 @@ def test_no_point_of_a_coarse_fig5_map_is_chaotic_and_all_are_held():
 
 def test_sweep_validates_its_inputs():
     with pytest.raises(ValueError, match="R"):
-        pc.rotation_sweep(BODY, [-1.0], [0.5])
+        pc.heading_sweep(BODY, [-1.0], [0.5])
     with pytest.raises(TypeError, match="steps"):
-        pc.rotation_sweep(BODY, [1.0], [0.5], steps=1.5)
+        pc.heading_sweep(BODY, [1.0], [0.5], steps=1.5)
     with pytest.raises(TypeError, match="unknown option"):
-        pc.rotation_sweep(BODY, [1.0], [0.5], bogus=1)
+        pc.heading_sweep(BODY, [1.0], [0.5], bogus=1)

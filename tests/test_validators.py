@@ -252,9 +252,11 @@ def test_an_explicit_run_that_stiffness_would_make_endless_is_refused_naming_the
     # the rate is the closed loop's: (kv + c) / m + sqrt(kp / m) on x, here 3.83e6 1/s
 
 
-@pytest.mark.parametrize("R, Theta, msg", [(1e9, 1.0, r"^R\[0\] = 1e\+09 m .* outside the verdicts' domain"),
-                                           (2.0, 1e9, r"^Theta\[0\] = 1e\+09 rad/s is outside the verdicts' domain "
-                                                      r"Theta <= 50\.27")])
+@pytest.mark.parametrize("R, Theta, msg", [(1e9, 1.0, r"^R\[0\] = 1e\+09 m: a period would need .* beyond the budget "
+                                                      r"of 16384; outside the verdicts' domain"),
+                                           (2.0, 1e9, r"^Theta\[0\] = 1e\+09 rad/s: the heading's damping time .* "
+                                                      r"the domain is \|Theta\| <= 50\.27"),
+                                           (1.0, 1e-9, r"^Theta\[0\] = 1e-09 rad/s: a period would need")])
 def test_a_fig5_point_outside_the_verdicts_domain_is_refused_at_once(R, Theta, msg):
     with pytest.raises(ValueError, match=msg):
         stability.eight_rotation_sweep(BODY, [R, 1.0], [Theta, 1.0])

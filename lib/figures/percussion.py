@@ -11,12 +11,12 @@ __all__ = ["plot_percussion_map", "plot_steady_pair"]
 
 def plot_percussion_map(frame, ax=None):
     """The range of the heading error p (rad) over (R, Theta) from a
-    :func:`lib.percussion.rotation_sweep` frame; lost points as black crosses. Returns the figure.
+    :func:`lib.percussion.heading_sweep` frame; lost points as black crosses. Returns the figure.
 
     Parameters
     ----------
     frame : pandas.DataFrame
-        A frame of :func:`lib.percussion.rotation_sweep` (or
+        A frame of :func:`lib.percussion.heading_sweep` (or
         :func:`lib.percussion.percussion_fig5_map`): columns R (m), Theta (rad/s), range (rad), lost.
     ax : matplotlib.axes.Axes, optional
         Where to draw; a new figure when None.

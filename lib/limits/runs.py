@@ -90,7 +90,8 @@ def _limits_arrays(angle_limits, force_limits):
         raise ValueError(f"angle_limits ({b.size}) and force_limits ({f.size}) must have equal lengths "
                          "(or length 1)") from None
     if not np.all((b > 0) & (b <= np.pi)):
-        raise ValueError(f"every angle limit must be in (0, pi] rad, got {b[~((b > 0) & (b <= np.pi))][:3]}")
+        i = int(np.flatnonzero(~((b > 0) & (b <= np.pi)))[0])
+        raise ValueError(f"angle_limits[{i}] must be in (0, pi] rad, got {float(b[i])!r}")
     if np.any(np.isnan(f)) or not np.all(f > 0):
         bad = f[np.isnan(f) | ~(f > 0)]
         raise ValueError(f"every force limit must be positive (N) or inf for none, got {bad[:3]}")

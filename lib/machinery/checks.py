@@ -13,7 +13,9 @@ first bad index), e.g. ``"R must be a finite number, got nan"`` or
 ``"Theta[3] must be finite, got nan"``.
 
 They are for the public edge (constructors, sweeps, ``simulate``); inner loops
-call unvalidated kernels.
+call unvalidated kernels. The methods' budget (:mod:`lib.machinery.domain`: a run refused
+before it starts when its steps or stiffness would exceed a stated budget) is re-exported
+here, so that every entry checks through this one module.
 """
 
 from __future__ import annotations
@@ -22,6 +24,9 @@ import numbers
 from typing import Any, Iterable, Mapping
 
 import numpy as np
+
+from .domain import (MAX_DAMPING_PERIODS, MAX_RUN_STEPS, MAX_STEPS, RK4_REACH, STEPS_PER_RADIAN,  # re-exported
+                     heading_damping, loop_domain, loop_modes, run_steps, scale_culprit, steps_domain, within_budget)
 
 __all__ = ["number", "integer", "array", "one_of", "flag", "instance", "options"]
 
@@ -155,8 +160,9 @@ def options(given: Mapping[str, Any], defaults: Mapping[str, Any], minima: Mappi
 
 
 def _first_bad(mask: np.ndarray) -> str:
+    """The index of the first True entry, ``"[2, 1]"``; empty for a scalar (no ``"[]"``)."""
     idx = np.argwhere(mask)[0]
-    return "[" + ", ".join(str(int(i)) for i in idx) + "]"
+    return "[" + ", ".join(str(int(i)) for i in idx) + "]" if idx.size else ""
 
 
 def array(name: str, value: Any, *, shape: tuple | None = None, finite: bool = True,

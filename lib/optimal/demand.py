@@ -44,7 +44,7 @@ from ..machinery import checks
 from ..params import Body
 from ..percussion.engine import HeadingEngine, coefficients
 from ..percussion.point import centre_of_percussion, lateral_drag_speed
-from ..percussion.sweep import rotation_sweep
+from ..percussion.sweep import heading_sweep
 from ..rotation.verdicts import FIG5_GRID
 from ..trajectories import POSITIONS
 from .bound import exact_peak_force
@@ -87,7 +87,7 @@ def _check_frame(frame, R: np.ndarray, Theta: np.ndarray) -> pd.DataFrame | None
     checks.instance("frame", frame, pd.DataFrame)
     missing = [c for c in _FRAME_COLUMNS if c not in frame.columns]
     if missing:
-        raise ValueError(f"frame must be a frame of lib.percussion.rotation_sweep, missing columns {missing}")
+        raise ValueError(f"frame must be a frame of lib.percussion.heading_sweep, missing columns {missing}")
     if len(frame) != R.size:
         raise ValueError(f"frame must have one row per point ({R.size}), got {len(frame)} rows")
     fR, fT = frame["R"].to_numpy(float), frame["Theta"].to_numpy(float)
@@ -255,7 +255,7 @@ def exact_force_map(body: Body, R, Theta, *, kind: str = "eight", point: str = "
     point : str
         ``"C"`` (centre of mass) or ``"P"`` (centre of percussion).
     frame : pandas.DataFrame, optional
-        For ``point="P"``: the verdicts of :func:`lib.percussion.rotation_sweep` (e.g.
+        For ``point="P"``: the verdicts of :func:`lib.percussion.heading_sweep` (e.g.
         :func:`lib.percussion.percussion_fig5_map`) of the same body and ``kind`` at the
         broadcast points in C order (columns R, Theta, regime, lost, orbit_p, period); None
         computes them. Checked, and unused, for ``point="C"``.
@@ -281,7 +281,7 @@ def exact_force_map(body: Body, R, Theta, *, kind: str = "eight", point: str = "
     if point == "C":
         return np.asarray(exact_peak_force(body, Rf, Tf, kind=kind), float).reshape(R.shape)
     if frame is None:
-        frame = rotation_sweep(body, Rf, Tf, kind=kind)
+        frame = heading_sweep(body, Rf, Tf, kind=kind)
     held = _held(frame)
     out = np.full(Rf.size, np.nan)
     if held.any():

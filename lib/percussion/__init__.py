@@ -16,7 +16,7 @@ from .point import (body_state_from_point, centre_of_percussion, drag_mismatch, 
                     point_accel, point_state)
 from .run import PercussionResult, designed_error_deviation, point_error, simulate
 from .compare import SteadyMotion, paper_steady, path_distance, percussion_steady, steady_table
-from .sweep import SWEEP_DEFAULTS, percussion_fig5_map, rotation_sweep
+from .sweep import SWEEP_DEFAULTS, heading_sweep, percussion_fig5_map, rotation_sweep  # rotation_sweep: the former name
 from .zero_dynamics import (CircleSteadyMotion, circle_lock_radius, circle_slip, circle_steady_motion,
                             frozen_lock, heading_rate, path_drive, zero_dynamics_run)
 
@@ -26,4 +26,4 @@ __all__ = ["PointDerivation", "derive_point", "DEFAULT_POLE", "applied_force", "
            "CircleSteadyMotion", "circle_lock_radius",
            "circle_steady_motion", "circle_slip", "frozen_lock", "heading_rate", "path_drive", "zero_dynamics_run",
            "SteadyMotion", "paper_steady", "path_distance", "percussion_steady", "steady_table", "SWEEP_DEFAULTS",
-           "percussion_fig5_map", "rotation_sweep"]
+           "percussion_fig5_map", "heading_sweep"]

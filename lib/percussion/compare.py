@@ -22,7 +22,7 @@ from ..rotation.reduced import reduced_rotation, rotation_orbit
 from ..trajectories import make
 from .engine import HeadingEngine, coefficients
 from .point import centre_of_percussion, lateral_drag_speed
-from .sweep import rotation_sweep
+from .sweep import heading_sweep
 from .zero_dynamics import heading_rate, path_drive
 
 __all__ = ["SteadyMotion", "paper_steady", "percussion_steady", "steady_table", "path_distance"]
@@ -97,7 +97,7 @@ def paper_steady(body: Body, kind: str, R: float, Theta: float, *, transient: in
 
 def percussion_steady(body: Body, kind: str, R: float, Theta: float, *, steps: int = 512) -> SteadyMotion:
     """The law for P with P on the path: one period of the zero dynamics' attracting orbit
-    (decided by :func:`lib.percussion.rotation_sweep`), the force and C along it.
+    (decided by :func:`lib.percussion.heading_sweep`), the force and C along it.
 
     Parameters
     ----------
@@ -124,7 +124,7 @@ def percussion_steady(body: Body, kind: str, R: float, Theta: float, *, steps: i
         If the heading is not held on an orbit of period 1.
     """
     R, Theta = _check(body, kind, R, Theta)
-    v = rotation_sweep(body, [R], [Theta], kind=kind, steps=steps)
+    v = heading_sweep(body, [R], [Theta], kind=kind, steps=steps)
     if v.regime[0] != "periodic" or v.period[0] != 1:
         raise ValueError(f"the heading is not held on a period-1 orbit at R = {R}, Theta = {Theta}")
     eng = HeadingEngine(kind, steps)

@@ -26,14 +26,32 @@ from ..rotation.verdicts import FIG5_GRID
 from ..dynamics.sampled import sampled_range
 from .engine import HeadingEngine, HeadingMap, coefficients
 
-__all__ = ["SWEEP_DEFAULTS", "rotation_sweep", "percussion_fig5_map"]
+__all__ = ["SWEEP_DEFAULTS", "heading_sweep", "percussion_fig5_map"]
 
 _DEFAULTS = dict(steps=128, transient=16, chunk=4, min_transient=4, max_period=4, lyapunov_periods=120, block=12,
                  newton_tol=1e-10, candidate_tol=0.05, reach_tol=0.05, reach_floor=1e-9, lyapunov_band=0.01,
                  slip_band=1e-3, return_tol=0.05)
-#: the default options of :func:`rotation_sweep` (read-only)
+#: the default options of :func:`heading_sweep` (read-only)
 SWEEP_DEFAULTS = MappingProxyType(_DEFAULTS)
 _NEWTON = dict(max_iter=30, max_step=1.0, polish=1e-13)
+#: the largest exponent h |S| of one Magnus step (exp of it stays far from overflow at 709; the book's
+#: Fig. 5 grid needs at most 8 at the default 128 steps a period)
+MAX_EXPONENT = 100.0
+
+
+def _check_domain(body: Body, kind: str, R, Theta, steps: int) -> None:
+    """Refuse a point whose heading turns so fast per period that ``steps`` Magnus steps would each
+    carry an exponent above :data:`MAX_EXPONENT` (the flow's matrix S grows as R Theta / eps and
+    R (c / m) / eps), naming R or Theta, whichever lies farther from the body's scales."""
+    eng = HeadingEngine(kind, 64)
+    cA, cV = coefficients(body, R, Theta)
+    rate = np.abs(cA) * np.hypot(eng.eX2, eng.eY2).max() + np.abs(cV) * np.hypot(eng.eX1, eng.eY1).max()
+    need = 2 * np.pi * rate / MAX_EXPONENT
+    by_r = checks.scale_culprit(body, R, Theta) == "R"
+    checks.within_budget({"R": np.where(by_r, need, 0), "Theta": np.where(by_r, 0, need)}, steps,
+                         what="a period would need", unit=f"Magnus steps (each step's exponent <= {MAX_EXPONENT:g})",
+                         values={"R": (R, "m"), "Theta": (Theta, "rad/s")},
+                         fix="raise the option steps, or keep R and Theta near the body's scales")
 
 
 def _options(options: dict) -> dict:
@@ -41,7 +59,7 @@ def _options(options: dict) -> dict:
                                                    block=2, lyapunov_periods=0))
 
 
-def rotation_sweep(body: Body, R, Theta, *, kind: str = "eight", p0=0.0, executor=None,
+def heading_sweep(body: Body, R, Theta, *, kind: str = "eight", p0=0.0, executor=None,
                    chunk_size: int | None = None, progress: bool | None = None, **options) -> pd.DataFrame:
     """The verdict on the heading under the law for P, P exactly on the path ``kind`` (the
     eight (28) by default) of size R_i (m) at Theta_i (rad/s), from p(0) = ``p0`` (rad), with
@@ -78,6 +96,7 @@ def rotation_sweep(body: Body, R, Theta, *, kind: str = "eight", p0=0.0, executo
     checks.one_of("kind", kind, ("eight", "circle"))
     R, Theta = check_grid(R, Theta)
     o = _options(options)
+    _check_domain(body, kind, R, Theta, o["steps"])
     p0 = checks.array("p0", p0)
     try:
         p0 = np.broadcast_to(p0, R.shape).copy()
@@ -88,9 +107,14 @@ def rotation_sweep(body: Body, R, Theta, *, kind: str = "eight", p0=0.0, executo
     return concat_frames(parts)
 
 
+#: the former name of :func:`heading_sweep` (deprecated, as it was also the name of
+#: :func:`lib.rotation.reduced.rotation_sweep`, Chapter 5's first-edition classifier)
+rotation_sweep = heading_sweep
+
+
 def percussion_fig5_map(body: Body, R_range=FIG5_GRID["R"], Theta_range=FIG5_GRID["Theta"],
                         n: int = FIG5_GRID["n"], **kw) -> pd.DataFrame:
-    """:func:`rotation_sweep` on the n x n grid of Fig. 5 (Theta varying slowest), as
+    """:func:`heading_sweep` on the n x n grid of Fig. 5 (Theta varying slowest), as
     :func:`lib.rotation.fig5.fig5_map` lays it out.
 
     Parameters
@@ -102,7 +126,7 @@ def percussion_fig5_map(body: Body, R_range=FIG5_GRID["R"], Theta_range=FIG5_GRI
     n : int
         Points per side (>= 2); default ``FIG5_GRID["n"]``.
     **kw
-        Keywords of :func:`rotation_sweep`.
+        Keywords of :func:`heading_sweep`.
 
     Returns
     -------
@@ -111,7 +135,7 @@ def percussion_fig5_map(body: Body, R_range=FIG5_GRID["R"], Theta_range=FIG5_GRI
     """
     n = checks.integer("n", n, minimum=2)
     R, Th = np.meshgrid(np.linspace(*R_range, n), np.linspace(*Theta_range, n))
-    return rotation_sweep(body, R.ravel(), Th.ravel(), **kw)
+    return heading_sweep(body, R.ravel(), Th.ravel(), **kw)
 
 
 def _new_out(N):

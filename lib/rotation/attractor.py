@@ -18,7 +18,7 @@ from ..angles import wrap_angle
 from ..dynamics.verdicts import REGIMES, orbit_points
 from ..params import Body
 from .reduced import check_grid, _shape
-from .engine import RotationMap, _Engine
+from .engine import RotationMap, _Engine, check_domain
 from .field import coefficients
 from .verdicts import SLOW_FLOQUET, _check_body_kind, _step_counts, _verdict_core, _verdict_options
 
@@ -117,6 +117,7 @@ def rotation_attractor(body: Body, kind: str, R: float, Theta: float, *, p0: flo
         raise ValueError("initial p0 and v0 must be finite")
     _check_body_kind(body, kind)
     h_lambda = checks.number("h_lambda", h_lambda, positive=True)
+    check_domain(body, kind, R_, Th, h_lambda)             # the verdicts' domain, before any run
     opts = _verdict_options(options)
     n_pts, n_fine = _step_counts(body, kind, R_, Th, h_lambda, steps, opts)
     n = int(n_fine[0])

@@ -13,6 +13,7 @@ import numpy as np
 
 from ..angles import wrap_angle
 from ..integrators import batch
+from ..machinery import checks
 from ..params import Body
 from .reduced import ENGINES, _forcing, _shape, _unit_forcing, steps_per_period
 from ..dynamics.sampled import sampled_range
@@ -220,12 +221,10 @@ def orbit_range(eng: _Engine, x, A, B, C, k: int, slip) -> tuple[np.ndarray, np.
 
 
 #: the most reference periods the heading's damping time I_C / c_phi may last where the rotation's
-#: verdicts are meant to hold (their transient runs 48 periods, so a start is forgotten before the
-#: orbit search begins)
-MAX_DAMPING_PERIODS = 8.0
-#: the most fixed steps a reference period may need (beyond, a point costs minutes, R far beyond
-#: the body's scale)
-MAX_STEPS = 2 ** 14
+#: verdicts are meant to hold (:data:`lib.machinery.domain.MAX_DAMPING_PERIODS`)
+MAX_DAMPING_PERIODS = checks.MAX_DAMPING_PERIODS
+#: the most fixed steps a reference period may need (:data:`lib.machinery.domain.MAX_STEPS`)
+MAX_STEPS = checks.MAX_STEPS
 
 
 def check_domain(body: Body, kind: str, R, Theta, h_lambda: float = 0.125) -> np.ndarray:
@@ -255,17 +254,8 @@ def check_domain(body: Body, kind: str, R, Theta, h_lambda: float = 0.125) -> np
         If a rate makes the heading's damping time longer than :data:`MAX_DAMPING_PERIODS`
         periods, or a point needs more than :data:`MAX_STEPS` steps a period.
     """
-    theta_max = 2 * np.pi * MAX_DAMPING_PERIODS * body.c_phi / body.I
-    bad = np.flatnonzero(Theta > theta_max)
-    if bad.size:
-        i = int(bad[0])
-        raise ValueError(f"Theta[{i}] = {Theta[i]:g} rad/s is outside the verdicts' domain Theta <= {theta_max:.4g} "
-                         f"rad/s (2 pi {MAX_DAMPING_PERIODS:g} c_phi / I_C): the heading would keep its start for more "
-                         "than the transient the verdicts allow")
+    checks.heading_damping(body, Theta)
     steps = steps_per_period(body, kind, R, Theta, h_lambda)
-    bad = np.flatnonzero(steps > MAX_STEPS)
-    if bad.size:
-        i = int(bad[0])
-        raise ValueError(f"R[{i}] = {R[i]:g} m with Theta[{i}] = {Theta[i]:g} rad/s is outside the verdicts' domain: "
-                         f"a period needs {steps[i]} steps, more than {MAX_STEPS} (R far beyond the body's scale)")
+    A, _, _ = coefficients(body, R, Theta)
+    checks.steps_domain(steps, 2 * np.pi * A / h_lambda, R, Theta)
     return steps

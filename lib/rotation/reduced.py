@@ -283,8 +283,11 @@ def rotation_sweep(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, tol: floa
     max_periods = checks.integer("max_periods", max_periods, minimum=max(min_periods, max_lag + 1))
     step_period = ENGINES[checks.one_of("engine", engine, sorted(ENGINES))]
     tol = checks.number("tol", tol, positive=True)
-    n_pts = (np.full(N, int(steps)) if steps is not None
-             else steps_per_period(body, kind, R, Theta, h_lambda))
+    h_lambda = checks.number("h_lambda", h_lambda, positive=True)
+    checks.heading_damping(body, Theta)               # the verdicts' domain, before any run
+    n_dom = steps_per_period(body, kind, R, Theta, h_lambda)
+    checks.steps_domain(n_dom, 2 * np.pi * coefficients(body, R, Theta)[0] / h_lambda, R, Theta)
+    n_pts = np.full(N, checks.integer("steps", steps, minimum=8)) if steps is not None else n_dom
     cols = {k: np.empty(N, dtype=object if k == "regime" else float)
             for k in ("range", "regime", "period", "slip", "defect", "periods")}
     for n in np.unique(n_pts):

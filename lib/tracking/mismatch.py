@@ -258,6 +258,8 @@ def mismatch_sweep(body: Body, gains: Gains, kind, R, Theta, mismatch: Mapping, 
     z0 = checks.array("z0", z0, shape=(3,))
     dz0 = checks.array("dz0", dz0, shape=(3,))
     o = _loop_options(options)
+    for k in set(kinds.tolist()):                 # the domain before any run (issue 37)
+        checks.loop_domain(body, gains, KINEMATICS[k], R[kinds == k], Theta[kinds == k], heading_gains=False)
     parts = map_chunks(_sweep_chunk, N, (kinds, R, Theta, scale),
                        dict(body=body, gains=gains, z0=z0, dz0=dz0, o=o), executor, chunk_size)
     return concat_frames(parts)

@@ -107,6 +107,7 @@ def closed_loop_batch(body: Body, gains: Gains, kind: str, R, Theta, weights=(1.
                             for n, v in (("t_end", t_end), ("dt", dt), ("record_dt", record_dt)))
     R, Theta, w = _points(R, Theta, weights)
     kin = KINEMATICS[kind]
+    checks.loop_domain(body, gains, kin, R, Theta, heading_gains=bool(np.any(w[:, 2] > 0)))
     loop = ClosedLoop.of(body, gains, lambda t: kin(R, Theta, t), Allocation(allocation, w), limits)
     zd0, dzd0, _ = kin(R, Theta, 0.0)
     z0 = zd0 if z0 is None else np.broadcast_to(checks.array("z0", z0), zd0.shape)

@@ -339,6 +339,9 @@ def closed_loop_verdicts(body: Body, gains: Gains, kind: str, R, Theta, weights=
     except ValueError:
         raise ValueError(f"kind has {kinds.size} entries for {R.size} points") from None
     o = _loop_options(options)
+    for k in set(kinds.tolist()):                 # the domain before any run (issue 37)
+        checks.loop_domain(body, gains, KINEMATICS[k], R[kinds == k], Theta[kinds == k],
+                           heading_gains=bool(np.any(w[:, 2] > 0)))
     N = R.size
     starts = []
     for name, v in (("z0", z0), ("dz0", dz0)):
