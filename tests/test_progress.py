@@ -83,3 +83,27 @@ def test_the_bar_is_labelled_with_the_sweep_the_user_called(monkeypatch):
 
     my_sweep()
     assert labels == ["my_sweep"]
+
+
+@pytest.mark.parametrize("entry", ["eight_rotation_sweep", "fig5_map"])
+def test_the_bar_of_a_sweep_that_runs_another_is_labelled_with_the_one_called(monkeypatch, entry):
+    # issue 37: the bars of eight_rotation_sweep and fig5_map said rotation_verdicts
+    import lib.machinery.parallel as P
+    from lib.rotation import fig5
+    labels = []
+    class Bar:
+        def update(self, k):
+            pass
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(P, "_bar", lambda total, desc: labels.append(desc) or Bar())
+    monkeypatch.setattr(P, "_run_chunks", lambda *a, **k: [pd.DataFrame()])   # the label only, no run
+    monkeypatch.setattr(fig5, "confirm_lost", lambda body, kind, frame, factor: frame)
+    monkeypatch.setattr(fig5, "confirm_attractors", lambda body, kind, frame, confirm: frame)
+    if entry == "fig5_map":
+        fig5.fig5_map(Body(), 2, progress=True)
+    else:
+        eight_rotation_sweep(Body(), [2.0], [0.5], progress=True)
+    assert labels == [entry]

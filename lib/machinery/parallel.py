@@ -26,7 +26,7 @@ import pandas as pd
 
 from . import checks
 
-__all__ = ["map_in_processes", "process_pool", "map_chunks", "chunk_slices", "executor_workers", "concat_frames",
+__all__ = ["map_in_processes", "process_pool", "check_executor", "map_chunks", "chunk_slices", "executor_workers", "concat_frames",
            "show_progress", "PROGRESS_CHUNKS"]
 
 #: with progress shown and no ``chunk_size`` nor executor, a sweep runs in about this many
@@ -66,9 +66,17 @@ def show_progress(progress: bool | None = None) -> bool:
 
 
 def _caller() -> str:
-    """The name of the function that asked for the work (the sweep a user called, e.g.
-    ``rotation_verdicts``), the progress bar's label."""
-    return sys._getframe(2).f_code.co_name
+    """The progress bar's label: the sweep the user called, that is the outermost public function
+    of ``lib`` (outside :mod:`lib.machinery`) on the way to :func:`map_chunks`
+    (``eight_rotation_sweep`` or ``fig5_map``, not the ``rotation_verdicts`` they run), or the
+    caller's own function when ``map_chunks`` is called from outside ``lib``."""
+    f = sys._getframe(2)
+    name = f.f_code.co_name
+    while f is not None and f.f_globals.get("__name__", "").startswith("lib."):
+        if not f.f_code.co_name.startswith("_") and not f.f_globals["__name__"].startswith("lib.machinery"):
+            name = f.f_code.co_name
+        f = f.f_back
+    return name
 
 
 def _bar(total: int, desc: str | None):
@@ -223,11 +231,52 @@ def chunk_slices(n: int, chunk_size: int) -> list[slice]:
     return [slice(a, min(a + chunk_size, n)) for a in range(0, n, chunk_size)]
 
 
-def _check_chunking(n, executor, chunk_size) -> int | None:
-    checks.integer("n", n, minimum=1)
-    if executor is not None and not isinstance(executor, Executor):
+def check_executor(executor) -> None:
+    """Refuse, in one sentence naming the fix, an executor the sweeps cannot use safely: not a
+    :class:`concurrent.futures.Executor`; a :class:`~concurrent.futures.ProcessPoolExecutor`
+    that *forks* its workers (Linux's default before Python 3.14: a fork after numba's threads
+    have run aborts, "fork() called from a process already using GNU OpenMP", and breaks the
+    pool); or one that spawns them from a script's top level outside
+    ``if __name__ == "__main__":`` (each worker would run the script again). A spawn or
+    forkserver pool in a guarded script, a notebook or the interpreter, a thread pool and a dask
+    ``Client.get_executor()`` pass; :func:`process_pool` builds the safe pool.
+
+    Parameters
+    ----------
+    executor : concurrent.futures.Executor or None
+        The executor a sweep was given (None passes).
+
+    Returns
+    -------
+    None
+        Raises instead when the executor is refused.
+
+    Raises
+    ------
+    TypeError
+        If ``executor`` is not an Executor.
+    ValueError
+        If it is a process pool that forks.
+    RuntimeError
+        If it spawns from an unguarded script.
+    """
+    if executor is None:
+        return
+    if not isinstance(executor, Executor):
         raise TypeError(f"executor must be a concurrent.futures.Executor (e.g. a process pool, or a dask "
                         f"Client.get_executor()), got {type(executor).__name__}")
+    if isinstance(executor, ProcessPoolExecutor):
+        ctx = getattr(executor, "_mp_context", None) or multiprocessing.get_context()
+        if ctx.get_start_method() == "fork":
+            raise ValueError("executor is a ProcessPoolExecutor that forks its workers, and a fork after numba's "
+                             "threads have run aborts; give it mp_context=multiprocessing.get_context('spawn'), "
+                             "or use lib.machinery.parallel.process_pool(n)")
+        _refuse_unguarded_script()
+
+
+def _check_chunking(n, executor, chunk_size) -> int | None:
+    checks.integer("n", n, minimum=1)
+    check_executor(executor)
     return None if chunk_size is None else checks.integer("chunk_size", chunk_size, minimum=1)
 
 
