@@ -36,3 +36,19 @@ def test_a_steady_window_longer_than_the_run_is_refused():
 def test_a_bad_force_limit_is_named_with_its_value():
     with pytest.raises(ValueError, match=r"-1"):
         limit_verdicts(BODY, GAINS, trajectories.eight(), [1.0], -1.0)
+
+
+def test_a_scalar_limit_is_named_without_an_empty_index():
+    # issue 37: "angle_limits[] must be finite"
+    with pytest.raises(ValueError, match=r"^angle_limits must be finite, got nan$"):
+        limit_verdicts(BODY, GAINS, trajectories.eight(), float("nan"))
+    with pytest.raises(ValueError, match=r"^angle_limits\[1\] must be in \(0, pi\] rad, got -1\.0$"):
+        limit_verdicts(BODY, GAINS, trajectories.eight(), [0.5, -1.0])
+
+
+def test_limit_verdicts_returns_a_named_pair_that_still_unpacks():
+    from lib.limits.verdicts import LimitVerdicts
+    out = limit_verdicts(BODY, GAINS, trajectories.circle(), [1.0], transient=4, periods=24)
+    assert isinstance(out, LimitVerdicts)
+    frame, runs = out                                   # the old unpacking
+    assert frame is out.frame and runs is out.runs and len(frame) == 1

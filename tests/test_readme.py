@@ -25,7 +25,7 @@ def test_readme_library_example_runs():
     proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
     header, *rows, last = proc.stdout.strip().splitlines()
-    assert header.split() == ["R", "Theta", "regime", "range", "lost"]
+    assert header.split() == ["R", "Theta", "regime", "range", "lost", "turns_round"]
     assert len(rows) == 9 and {r.split()[3] for r in rows} <= {"periodic", "slipping", "chaotic",
                                                                 "quasiperiodic", "undecided"}
     assert float(last.split()[0]) <= 4.0 + 1e-15          # exact: a clip; measured 0 over the cap; F never above the cap

@@ -14,6 +14,8 @@ re-exported here, and :func:`limit_verdicts`, which Chapter 4 uses). The verdict
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 import pandas as pd
 
@@ -33,7 +35,7 @@ from ..trajectories import Reference, heading_turns
 
 __all__ = [
     "error_state", "stroboscopic_section", "Regime", "classify", "section_sweep", "sweep_angle_limit",
-    "SwitchedRuns", "switched_runs", "limit_verdicts", "extend_undecided", "UNDECIDED_FACTOR", "regime_edges", "LIMIT_DEFAULTS", "STEPS_PER_PERIOD",
+    "SwitchedRuns", "switched_runs", "limit_verdicts", "LimitVerdicts", "extend_undecided", "UNDECIDED_FACTOR", "regime_edges", "LIMIT_DEFAULTS", "STEPS_PER_PERIOD",
     # re-exported from where they are defined
     "SwitchedLoop", "Segments", "largest_lyapunov", "LyapunovEstimate", "distinct_points", "section_period",
     "section_margin", "state_difference",
@@ -47,6 +49,15 @@ __all__ = [
 LIMIT_DEFAULTS = dict(transient=60, periods=120, block=12, max_period=8, candidate_tol=1e-3, newton_tol=1e-9,
                       fd_step=1e-6, reach_tol=1e-3, approach_tol=0.05, lyapunov_band=0.01, return_tol=0.05,
                       slip_band=1e-3)
+
+class LimitVerdicts(NamedTuple):
+    """What :func:`limit_verdicts` returns: ``frame``, one row of verdicts per pair, and ``runs``,
+    the :class:`SwitchedRuns` behind it (the sections and trajectories Chapter 4 draws). A tuple,
+    so that ``frame, runs = limit_verdicts(...)`` unpacks it as before."""
+
+    frame: pd.DataFrame
+    runs: SwitchedRuns
+
 
 #: Newton on the switched loop's period map: the Jacobian by differences, steps cut to 0.1
 _NEWTON = dict(max_iter=9, max_step=0.1)
@@ -149,10 +160,9 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
 
     Returns
     -------
-    frame : pandas.DataFrame
-        One row per pair, the columns above.
-    runs : SwitchedRuns
-        The runs behind it, in the order of the pairs.
+    LimitVerdicts
+        A named pair: ``frame`` (pandas.DataFrame), one row per pair, the columns above; ``runs``
+        (:class:`SwitchedRuns`), the runs behind it, in the order of the pairs.
     """
     o = checks.options(options, LIMIT_DEFAULTS, dict(transient=0, periods=2, block=2, max_period=1))
     npr, blk, kmax = o["periods"], o["block"], o["max_period"]
@@ -167,8 +177,8 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
                                                              steps_per_period=steps_per_period, locator=locator),
                        executor, chunk_size, progress)
     if len(parts) == 1:
-        return parts[0]
-    return pd.concat([p[0] for p in parts], ignore_index=True), _concat_runs([p[1] for p in parts])
+        return LimitVerdicts(*parts[0])
+    return LimitVerdicts(pd.concat([p[0] for p in parts], ignore_index=True), _concat_runs([p[1] for p in parts]))
 
 
 def _limit_chunk(b, f, S0, *, body, gains, ref, o, steps_per_period, locator):
