@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from lib.limits import torus
+from lib.limits import switchings, torus
 from lib.params import Body, Gains
 from lib.trajectories import eight
 
@@ -61,3 +61,24 @@ def test_invariant_circle_grows_as_the_square_root_of_the_distance(birth):
     # supercritical: amplitude ~ (F - F_c)^(1/2), to first order in the distances (0.01, 0.03 N)
     assert birth.amplitude_exponent == pytest.approx(0.5, abs=0.1)  # reason: first order in distances 0.01, 0.03 N
     assert all(c.amplitude < 0.5 for c in birth.circles)     # small, born at the orbit
+
+
+def test_the_difference_companions_meet_the_orbits_switchings_in_the_same_number_and_order(birth):
+    # the multipliers come from forward differences across Filippov switchings: at both caps
+    # one xtol from the crossing, the orbit and its six companions x + h e_j locate the same
+    # number of events, and at every step of the period each companion is in the orbit's mode
+    census = switchings.crossing_census(Body(), Gains(), eight(), birth)
+    assert census["events_min"] == census["events_max"] > 0
+    assert census["differing"] == 0 and census["mode_changes_min"] > 0
+    assert census["residual"] <= 1e-9          # accuracy: Newton's tolerance on the orbits
+    assert census["spread"] < 1e3              # reason: the quotient stays O(1) along the period (measured 18)
+
+
+def test_a_companion_across_a_switching_is_caught():
+    # the census is not blind: companions 0.2 away in each coordinate (m, rad, m/s, rad/s) leave
+    # the orbit's modes somewhere in the period
+    body, gains, ref = Body(), Gains(), eight()
+    b, f = math.radians(torus.NS_ANGLE_DEG), torus.NS_START_CAP
+    x = torus.section_centre(body, gains, ref, b, f)
+    census = switchings.switching_census(body, gains, ref, b, f, x, fd_step=0.2)
+    assert census.differing.max() > 0
