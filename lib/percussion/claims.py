@@ -44,8 +44,9 @@ class SteadyExtremes:
     """Extremes over one period of a steady motion: ``F_peak`` (N) and ``F_change`` (N, its change
     from half the samples); ``beta_peak`` (rad) the largest |beta| (pi when the force points
     backwards along the axis) and ``beta_change`` (rad); ``thrust_min`` (N) the smallest
-    u1 = F cos beta; ``reversed_time`` (s) the time a period with u1 < 0; ``backward`` the sign
-    changes of u2 while u1 < 0 (each one a passage of beta through pi)."""
+    u1 = F cos beta (refined as the peak is); ``reversed_time`` (s) the time a period with u1 < 0
+    (the share of samples); ``backward`` the sign changes of u2 while u1 < 0 (each one a passage
+    of beta through pi)."""
 
     F_peak: float
     F_change: float
@@ -63,8 +64,8 @@ def _peaks(F, beta, period):
     both = rev & np.roll(rev, -1)
     backward = int(np.count_nonzero(both & (np.sign(u2) != np.sign(np.roll(u2, -1)))))
     b = math.pi if backward else float(sampled_extremes(np.abs(beta)[None, :])[1][0])
-    return (float(sampled_extremes(F[None, :])[1][0]), b, float(u1.min()), float(rev.mean() * period),
-            backward)
+    return (float(sampled_extremes(F[None, :])[1][0]), b, float(sampled_extremes(u1[None, :])[0][0]),
+            float(rev.mean() * period), backward)
 
 
 def steady_extremes(body: Body, law: str, kind: str, R: float, Theta: float, steps: int = 2048) -> SteadyExtremes:

@@ -20,11 +20,12 @@ from ..machinery import checks
 from ..params import Body, Gains
 from .full_loop import full_loop_verdicts
 
-__all__ = ["MODEL_PARAMETERS", "wrong_model_study"]
+__all__ = ["MODEL_PARAMETERS", "MODEL_SYMBOLS", "wrong_model_study", "error_table"]
 
 #: the body's parameters the law for P uses, in the order of the study
 MODEL_PARAMETERS = ("m", "I", "a", "c", "c_phi")
-_SYMBOLS = {"I": "I_C"}
+#: how the book writes each parameter
+MODEL_SYMBOLS = {"m": "m", "I": "I_C", "a": "a", "c": "c", "c_phi": "c_phi"}
 
 
 def wrong_model_study(body: Body, gains: Gains, R: float, Theta: float, deltas=(-0.1, -0.05, 0.05, 0.1),
@@ -90,5 +91,5 @@ def error_table(study: pd.DataFrame) -> pd.DataFrame:
     wide = table.pivot(index="parameter", columns="column", values="cell")
     order = [f"{d:+.0%}".replace("%", " %") for d in sorted(set(off.delta))]
     wide = wide.reindex(index=[p for p in MODEL_PARAMETERS if p in set(off.parameter)], columns=order)
-    wide.index, wide.columns.name = [_SYMBOLS.get(p, p) for p in wide.index], None
+    wide.index, wide.columns.name = [MODEL_SYMBOLS[p] for p in wide.index], None
     return wide.rename_axis("model's parameter").reset_index()
