@@ -183,3 +183,9 @@ def test_under_the_cap_the_thrust_state_leaves_the_applied_thrust_and_runs_away(
     assert cap.xi_over > 4.0 and cap.t_over < cap.t_end
     assert cap.F_applied <= 4.0 + 1e-12          # exact: the applied force is clipped to the cap
     assert abs(cap.omega_end) < 100.0            # reason: the body turns slowly (measured 5.8 rad/s)
+
+
+@pytest.mark.parametrize("R, Theta, name", [(1e4, 1.0, "R"), (1.0, 1e-5, "Theta")])
+def test_a_point_beyond_the_step_budget_is_refused_naming_its_argument(R, Theta, name):
+    with pytest.raises(ValueError, match=f"^{name}"):
+        fl.full_loop_verdicts(BODY, GAINS, [R], [Theta])

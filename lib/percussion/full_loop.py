@@ -41,7 +41,8 @@ from ..trajectories import eight_kinematics
 from .law import error_polynomial
 from .point import centre_of_percussion, lateral_drag_speed, point_accel, point_state
 
-__all__ = ["FULL_LOOP_OPTIONS", "THRUST0", "grid_sample", "compiled_rates", "steps_per_period", "FullLoopMap",
+__all__ = ["FULL_LOOP_OPTIONS", "THRUST0", "MAX_STEPS", "grid_sample", "compiled_rates", "steps_per_period",
+           "FullLoopMap",
            "full_loop_verdicts", "compare_with_zero_dynamics"]
 
 #: the thrust state at the start (N), as Chapter 7 starts the law for P
@@ -53,6 +54,9 @@ THRUST0 = 0.5
 FULL_LOOP_OPTIONS = dict(chunk=6, max_periods=30, max_period=2, candidate_tol=1e-3, newton_tol=1e-8,
                          reach_tol=1e-4, reach_floor=1e-8, fd_step=1e-6, newton_iter=12, h_rate=0.25,
                          min_steps=64, position_tol=0.1)
+#: the most RK4 steps a period a point may need (:func:`steps_per_period`; the Fig. 5 grid needs
+#: at most 6808 at the default h_rate)
+MAX_STEPS = 2**16
 _MINIMA = dict(chunk=3, max_periods=3, max_period=1, newton_iter=1, min_steps=8)
 
 
@@ -336,6 +340,11 @@ def full_loop_verdicts(body: Body, gains: Gains, R, Theta, *, thrust0: float = T
         checks.instance("model", model, Body)
     N = R.size
     steps = steps_per_period(body, gains, R, Theta, o["h_rate"], o["min_steps"], np.r_[PAPER_Z0, PAPER_DZ0, thrust0])
+    by_r = checks.scale_culprit(body, R, Theta) == "R"
+    checks.within_budget({"R": np.where(by_r, steps, 0), "Theta": np.where(by_r, 0, steps)}, MAX_STEPS,
+                         what="a period would need", unit="RK4 steps",
+                         values={"R": (R, "m"), "Theta": (Theta, "rad/s")},
+                         fix="keep R and Theta near the body's scales, or raise the option h_rate")
     fmap = FullLoopMap(body, gains, R, Theta, steps, model, o["fd_step"])
     out = dict(regime=np.full(N, "undecided", dtype=object), period=np.zeros(N, int), turns=np.zeros(N, int),
                lost=np.zeros(N, bool), floquet=np.full(N, np.nan), orbit=np.full((N, 7), np.nan),
