@@ -51,7 +51,7 @@ THRUST0 = 0.5
 #: the procedure's options (state units m, rad, m/s, rad/s, N); periods in rounds of ``chunk``
 #: up to ``max_periods``, searched for an orbit of period <= ``max_period`` after each round;
 #: ``h_rate`` the bound on h times the largest rate; ``position_tol`` the tracking tolerance in units of R
-FULL_LOOP_OPTIONS = dict(chunk=6, max_periods=30, max_period=2, candidate_tol=1e-3, newton_tol=1e-8,
+FULL_LOOP_OPTIONS = dict(chunk=6, max_periods=30, max_period=4, candidate_tol=1e-3, newton_tol=1e-8,
                          reach_tol=1e-4, reach_floor=1e-8, fd_step=1e-6, newton_iter=12, h_rate=0.25,
                          min_steps=64, position_tol=0.1)
 #: the most RK4 steps a period a point may need (:func:`steps_per_period`; the Fig. 5 grid needs
