@@ -189,3 +189,10 @@ def test_under_the_cap_the_thrust_state_leaves_the_applied_thrust_and_runs_away(
 def test_a_point_beyond_the_step_budget_is_refused_naming_its_argument(R, Theta, name):
     with pytest.raises(ValueError, match=f"^{name}"):
         fl.full_loop_verdicts(BODY, GAINS, [R], [Theta])
+
+
+def test_p_starts_off_the_path_by_the_paper_start_and_s_p():
+    # the eight passes the origin at t = 0; the paper's C is at (1, 0) m facing +y, P is s_P along it
+    got = fl.start_error(BODY, [0.25, 4.0], [0.05, 1.5])
+    want = math.hypot(1.0, pc.centre_of_percussion(BODY))
+    np.testing.assert_allclose(got, want, rtol=1e-12)   # exact: closed forms, to rounding

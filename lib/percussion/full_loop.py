@@ -42,7 +42,7 @@ from .law import error_polynomial
 from .point import centre_of_percussion, lateral_drag_speed, point_accel, point_state
 
 __all__ = ["FULL_LOOP_OPTIONS", "THRUST0", "MAX_STEPS", "grid_sample", "compiled_rates", "steps_per_period",
-           "FullLoopMap",
+           "start_error", "FullLoopMap",
            "full_loop_verdicts", "compare_with_zero_dynamics"]
 
 #: the thrust state at the start (N), as Chapter 7 starts the law for P
@@ -218,6 +218,30 @@ def _error_drive(body: Body, gains: Gains, R, Theta, x0) -> np.ndarray:
         x = np.einsum("ij,tj,jn->tin", V, np.exp(np.outer(t, lam)), c).real           # (t, 3, N)
         worst = np.maximum(worst, (np.abs(x[:, 2]) + k * np.abs(x[:, 1])).max(axis=0))
     return worst
+
+
+def start_error(body: Body, R, Theta, x0=None) -> np.ndarray:
+    """P's distance from the path's point P_d(0) at the start (m), per point of the eight.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    R, Theta : array_like
+        The points (m, rad/s).
+    x0 : array_like, optional
+        The start (7,) or its first six entries; default the paper's.
+
+    Returns
+    -------
+    numpy.ndarray
+        (N,) |P(0) - P_d(0)| (m).
+    """
+    R, Theta = np.atleast_1d(np.asarray(R, float)), np.atleast_1d(np.asarray(Theta, float))
+    x0 = np.r_[PAPER_Z0, PAPER_DZ0] if x0 is None else np.asarray(x0, float)
+    P, _ = point_state(body, x0[:3], x0[3:6])
+    zd = eight_kinematics(R, Theta, 0.0)[0]
+    return np.hypot(zd[:, 0] - P[0], zd[:, 1] - P[1])
 
 
 def steps_per_period(body: Body, gains: Gains, R, Theta, h_rate: float = 1.0, min_steps: int = 64,
