@@ -20,7 +20,7 @@ from ..machinery import checks
 from ..params import Body, Gains
 from .full_loop import full_loop_verdicts
 
-__all__ = ["MODEL_PARAMETERS", "MODEL_SYMBOLS", "wrong_model_study", "error_table"]
+__all__ = ["MODEL_PARAMETERS", "MODEL_SYMBOLS", "wrong_model_study", "delta_label", "error_table"]
 
 #: the body's parameters the law for P uses, in the order of the study
 MODEL_PARAMETERS = ("m", "I", "a", "c", "c_phi")
@@ -69,6 +69,21 @@ def wrong_model_study(body: Body, gains: Gains, R: float, Theta: float, deltas=(
     return pd.DataFrame(rows)
 
 
+def delta_label(delta: float) -> str:
+    """A relative error as the book writes it, with its sign: 0.05 -> "+5 %".
+
+    Parameters
+    ----------
+    delta : float
+        The relative error.
+
+    Returns
+    -------
+    str
+    """
+    return f"{delta:+.0%}".replace("%", " %")
+
+
 def error_table(study: pd.DataFrame) -> pd.DataFrame:
     """The study as a table: one row a parameter, one column a relative error, each cell the
     tracked point's largest distance from the path on the orbit (m, 3 decimals) or the regime
@@ -87,9 +102,9 @@ def error_table(study: pd.DataFrame) -> pd.DataFrame:
     off = study[study.parameter != "none"]
     cell = [f"{r.P_error:.3f}" if r.held else ("diverged" if r.reason == "diverged" else r.regime)
             for r in off.itertuples()]
-    table = off.assign(cell=cell, column=[f"{d:+.0%}".replace("%", " %") for d in off.delta])
+    table = off.assign(cell=cell, column=[delta_label(d) for d in off.delta])
     wide = table.pivot(index="parameter", columns="column", values="cell")
-    order = [f"{d:+.0%}".replace("%", " %") for d in sorted(set(off.delta))]
+    order = [delta_label(d) for d in sorted(set(off.delta))]
     wide = wide.reindex(index=[p for p in MODEL_PARAMETERS if p in set(off.parameter)], columns=order)
     wide.index, wide.columns.name = [MODEL_SYMBOLS[p] for p in wide.index], None
     return wide.rename_axis("model's parameter").reset_index()
