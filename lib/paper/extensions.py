@@ -124,8 +124,8 @@ def _check_fig5_map() -> Outcome:
                    f"each point decided (periodic orbits with Floquet multipliers, Lyapunov exponents, drift); "
                    f"not held at {r['not_held']} points, the heading lost (slips) at {r['lost']} of them, and "
                    f"turning round (ranging over more than a turn) at {r['turns_round']}; the drift test "
-                   f"decided {tested} points and would call at most {chance:.1f} of them lost on average were none "
-                   f"to drift, so the lost count is a lower bound with few false positives")
+                   f"decided {tested} points and, were none of them to drift, would still call at most {chance:.1f} "
+                   f"of them lost on average")
 
 
 def _check_weighted_circle() -> Outcome:
