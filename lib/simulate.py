@@ -98,18 +98,6 @@ def _instance(name: str, value, cls):
 EXPLICIT_METHODS = ("RK23", "RK45", "DOP853")
 
 
-def _path_extremes(ref) -> tuple[float, float]:
-    """The largest speed (m/s) and acceleration (m/s^2) of the book's circle or eight over one
-    period, sampled at 257 times: what the reference makes the heading's stiffness (32). A
-    reference of the caller's own making gives (0, 0): its run is bounded by the gains' budget
-    and watched for blow-ups as it goes."""
-    if not isinstance(ref, (Circle, Eight)):
-        return 0.0, 0.0
-    t = np.linspace(0.0, ref.period, 257)
-    dz, ddz = np.asarray(ref.dz(t), float), np.asarray(ref.ddz(t), float)
-    return float(np.hypot(dz[:, 0], dz[:, 1]).max()), float(np.hypot(ddz[:, 0], ddz[:, 1]).max())
-
-
 def _check_budget(body: Body, gains: Gains, ref, t_end: float, integration, allocation) -> None:
     """Refuse an explicit run whose fastest mode (the gains', or the heading's driven by the path,
     :func:`lib.machinery.domain.loop_modes`) would make it take more than
@@ -118,7 +106,7 @@ def _check_budget(body: Body, gains: Gains, ref, t_end: float, integration, allo
         checks.heading_damping(body, ref.theta, "ref.theta")
     if integration.method not in EXPLICIT_METHODS:
         return
-    speed, accel = _path_extremes(ref)
+    speed, accel = checks.path_extremes(ref)
     modes = checks.loop_modes(body, gains, speed=speed, accel=accel, heading_gains=allocation.law != "position")
     named = {"ref": f"ref (R = {ref.R:g} m, theta = {ref.theta:g} rad/s)"} if isinstance(ref, (Circle, Eight)) else {}
     need = {named.get(name, name): checks.run_steps(mode, t_end) for name, mode in modes.items()}

@@ -19,6 +19,9 @@ from lib.rotation import attractor, reduced
 from lib.simulate import simulate
 from lib.tracking import mismatch, runs as tracking
 from lib.weighting import batch as weighting_batch, comparison, verdicts as loop_verdicts
+from lib.optimal import bound as optimal_bound, motion as optimal_motion, study as optimal_study
+from lib.percussion import compare as percussion_compare, zero_dynamics
+from lib.rotation import circle_global, slow_eight
 
 B, G = Body(), Gains()
 R0, TH0 = 2.0, 0.5                      # a point inside every domain
@@ -56,6 +59,22 @@ ENTRIES = [
      {"tol": -1.0}),
     ("force_cap_sweep", lambda R, Th, **o: tracking.force_cap_sweep(B, G, T.eight(R, Th), [4.0], **o),
      {"n_steady": 0}),
+    ("mismatch_study", lambda R, Th, **o: mismatch.mismatch_study(B, G, R, Th, **o), {"levels": ()}),
+    ("compare_on_map", lambda R, Th, **o: comparison.compare_on_map(B, G, [R], [Th], **dict(dict(w_phi=0.5), **o)),
+     {"w_phi": -1.0}),
+    ("percussion_steady", lambda R, Th, **o: percussion_compare.percussion_steady(B, "eight", R, Th, **o),
+     {"steps": 1}),
+    ("paper_steady", lambda R, Th, **o: percussion_compare.paper_steady(B, "eight", R, Th, **o), {"transient": 0}),
+    ("zero_dynamics_run", lambda R, Th, **o: zero_dynamics.zero_dynamics_run(B, T.eight(R, Th), [0.0, 10.0], 0.0, **o),
+     {"rtol": -1.0}),
+    ("circle_final_state", lambda R, Th, **o: circle_global.circle_final_state(B, R, Th, **o), {"t_max": -1.0}),
+    ("circle_slipping_coexists", lambda R, Th, **o: circle_global.circle_slipping_coexists(B, R, Th, **o),
+     {"t_end": 0.0}),
+    ("homoclinic_miss", lambda R, Th, **o: circle_global.homoclinic_miss(B, R, Th, **o), {"rtol": 0.0}),
+    ("slow_eight_prediction", lambda R, Th, **o: slow_eight.slow_eight_prediction(B, R, Th, **o), {"n_phase": 8}),
+    ("cap_bound", lambda R, Th, **o: optimal_bound.cap_bound(B, R, Th, 4.0, **o), {"nodes": 8}),
+    ("cap_sweep", lambda R, Th, **o: optimal_study.cap_sweep(B, R, Th, [4.0], **o), {"kind": "square"}),
+    ("periodic_motion", lambda R, Th, **o: optimal_motion.periodic_motion(B, R, Th, **o), {"nodes": 4}),
 ]
 IDS = [e[0] for e in ENTRIES]
 

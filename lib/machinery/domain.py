@@ -15,8 +15,9 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["loop_modes", "run_steps", "within_budget", "scale_culprit", "heading_damping", "steps_domain",
-           "loop_domain", "MAX_RUN_STEPS", "STEPS_PER_RADIAN", "MAX_STEPS", "MAX_DAMPING_PERIODS", "RK4_REACH"]
+__all__ = ["loop_modes", "run_steps", "within_budget", "scale_culprit", "by_scale", "heading_damping", "steps_domain",
+           "loop_domain", "path_budget", "path_extremes", "MAX_RUN_STEPS", "MAX_ODE_STEPS", "STEPS_PER_RADIAN",
+           "MAX_STEPS", "MAX_DAMPING_PERIODS", "RK4_REACH"]
 
 #: the most steps an explicit adaptive run (:func:`lib.simulate.simulate`) may be expected to take,
 #: at about 1.3 ms a step of DOP853 on the closed loop in Python, about a minute of CPU
@@ -25,6 +26,9 @@ MAX_RUN_STEPS = 4e4
 #: on the closed loop with stiff gains or a large path); a decaying mode costs its rate times the
 #: span over 4 (the method's stability reaches about 4 along the negative real axis)
 STEPS_PER_RADIAN = 10.0
+#: the most steps an adaptive run of two states ((33), the zero dynamics) may be expected to take,
+#: at about 50 us a step of ``solve_ivp`` on them, about a minute of CPU
+MAX_ODE_STEPS = 1e6
 #: the most fixed steps a reference period may need in a sweep over (R, Theta) (beyond, a point
 #: costs minutes, R far beyond the body's scale, or Theta far below its rates)
 MAX_STEPS = 2 ** 14
@@ -153,6 +157,31 @@ def scale_culprit(body, R, Theta) -> np.ndarray:
     return np.where(r >= t, "R", "Theta")
 
 
+def by_scale(body, R, Theta, need, names=("R", "Theta")) -> dict:
+    """``need`` (a cost set by R and Theta together, one per point) laid on the argument that
+    lies farther from the body's scales (:func:`scale_culprit`), for :func:`within_budget`.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    R, Theta : array_like
+        The points.
+    need : array_like
+        The cost per point.
+    names : tuple of str
+        How the caller names R and Theta.
+
+    Returns
+    -------
+    dict
+        {names[0]: the cost where R is the culprit, else 0; names[1]: the rest}.
+    """
+    by_r = scale_culprit(body, R, Theta) == "R"
+    need = np.asarray(need, float) * np.ones(by_r.shape)
+    return {names[0]: np.where(by_r, need, 0), names[1]: np.where(by_r, 0, need)}
+
+
 #: the largest h |lambda| of a fixed-step sweep's RK4 step (its stability reaches about 2.8)
 RK4_REACH = 2.5
 
@@ -221,8 +250,9 @@ def loop_domain(body, gains, kin, R, Theta, *, heading_gains: bool = True) -> No
     ----------
     body : Body
         The body.
-    gains : Gains
-        The gains of (23).
+    gains : Gains or None
+        The gains of (23); None for a loop without them (the paper's inputs given, as the optimal
+        motions').
     kin : callable
         The path's kinematics, vectorised.
     R, Theta : numpy.ndarray
@@ -241,11 +271,75 @@ def loop_domain(body, gains, kin, R, Theta, *, heading_gains: bool = True) -> No
     _, dz, ddz = kin(R[:, None], Theta[:, None], np.linspace(0.0, 1.0, 65)[None, :] * T[:, None])
     modes = loop_modes(body, gains, speed=np.hypot(dz[..., 0], dz[..., 1]).max(axis=1),
                        accel=np.hypot(ddz[..., 0], ddz[..., 1]).max(axis=1), heading_gains=heading_gains)
-    by_r = scale_culprit(body, R, Theta) == "R"
-    ref = T * np.abs(modes["ref"]) / RK4_REACH
-    need = {"gains": T * abs(modes["body and gains"]) / RK4_REACH, "R": np.where(by_r, ref, 0),
-            "Theta": np.where(by_r, 0, ref)}
+    need = by_scale(body, R, Theta, T * np.abs(modes["ref"]) / RK4_REACH)
+    if gains is not None:
+        need["gains"] = T * abs(modes["body and gains"]) / RK4_REACH
     within_budget(need, MAX_STEPS, what="a period would need", unit="fixed steps",
                   values={"R": (R, "m"), "Theta": (Theta, "rad/s")},
                   fix="outside the sweep's domain (stiff gains, R far beyond the body's scale or Theta far "
                   "from its rates)")
+
+
+def path_budget(body, R, Theta, span, *, speed: float = 1.0, accel: float = 1.0, names=("R", "Theta"),
+                limit: float = MAX_RUN_STEPS, damping: bool = True) -> None:
+    """The domain of an adaptive run of the heading driven by a path of size R (m) at rate
+    Theta (rad/s) over ``span`` (s, scalar or per point): the heading's damping time
+    (:func:`heading_damping`), then :data:`MAX_RUN_STEPS` steps of its fastest mode
+    (:func:`loop_modes` at the path's largest speed ``speed`` R Theta and acceleration
+    ``accel`` R Theta^2, ``speed`` and ``accel`` those of the unit path: 1 and 1 on the circle),
+    laid on R or Theta by :func:`scale_culprit`. Refuses the first point outside, naming it.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    R, Theta : float or array_like
+        The points.
+    span : float or array_like
+        The run's length (s).
+    speed, accel : float
+        The unit path's largest speed and acceleration.
+    names : tuple of str
+        How the caller names R and Theta.
+    limit : float
+        The budget of steps: :data:`MAX_RUN_STEPS` (the closed loop), or :data:`MAX_ODE_STEPS` (a
+        run of two states).
+    damping : bool
+        Whether to check the heading's damping time too (a verdict after a transient); False for
+        the circle's autonomous (33), analysed in its phase plane.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument and index.
+    """
+    R, Theta = np.broadcast_arrays(np.atleast_1d(np.asarray(R, float)), np.atleast_1d(np.asarray(Theta, float)))
+    if damping:
+        heading_damping(body, Theta, names[1])
+    mode = loop_modes(body, speed=speed * R * np.abs(Theta), accel=accel * R * Theta ** 2)["ref"]
+    within_budget(by_scale(body, R, Theta, run_steps(mode, span), names), limit,
+                  what="the run would need", unit="steps", values={names[0]: (R, "m"), names[1]: (Theta, "rad/s")},
+                  fix="outside the methods' domain (R far beyond the body's scale, or Theta far from its rates)")
+
+
+def path_extremes(ref) -> tuple[float, float]:
+    """The largest speed (m/s) and acceleration (m/s^2) of a path of the book (a reference with
+    ``R``, ``theta``, ``period``, ``dz`` and ``ddz``: :class:`lib.trajectories.Circle` or
+    :class:`lib.trajectories.Eight`) over one period, sampled at 257 times; (0, 0) for a reference
+    of the caller's own making, whose run is then watched for blow-ups as it goes.
+
+    Parameters
+    ----------
+    ref : Reference
+        The reference.
+
+    Returns
+    -------
+    tuple of float
+        Speed (m/s) and acceleration (m/s^2).
+    """
+    if not all(hasattr(ref, k) for k in ("R", "theta", "period", "dz", "ddz")):
+        return 0.0, 0.0
+    t = np.linspace(0.0, ref.period, 257)
+    dz, ddz = np.asarray(ref.dz(t), float), np.asarray(ref.ddz(t), float)
+    return float(np.hypot(dz[:, 0], dz[:, 1]).max()), float(np.hypot(ddz[:, 0], ddz[:, 1]).max())

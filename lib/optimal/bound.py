@@ -41,7 +41,7 @@ from scipy.optimize import minimize_scalar
 
 from ..machinery import checks
 from ..params import Body
-from ..trajectories import POSITIONS
+from ..trajectories import KINEMATICS, POSITIONS
 
 __all__ = ["IntervalMap", "interval_map", "exact_peak_force", "CapBound", "cap_bound", "MAX_NODES"]
 
@@ -393,6 +393,7 @@ def cap_bound(body: Body, R: float, Theta: float, F_max: float, *, kind: str = "
     Theta = checks.number("Theta", Theta, positive=True, unit="rad/s")
     F_max = checks.number("F_max", F_max, positive=True, unit="N")
     checks.one_of("kind", kind, _KINDS)
+    checks.loop_domain(body, None, KINEMATICS[kind], [R], [Theta], heading_gains=False)  # before any solve
     N = checks.integer("nodes", nodes, minimum=16)
     if N > MAX_NODES:
         raise ValueError(f"nodes must be at most MAX_NODES = {MAX_NODES}, got {N}")

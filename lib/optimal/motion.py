@@ -34,7 +34,7 @@ from ..model import config_from_state, state_from_config
 from ..params import Body
 from ..percussion import paper_steady
 from ..simulate import simulate_open_loop
-from ..trajectories import POSITIONS, heading_turns, make
+from ..trajectories import KINEMATICS, POSITIONS, heading_turns, make
 from .collocation import ACCEPTED, tableau, transcription
 
 __all__ = ["PeriodicMotion", "periodic_motion", "verify_motion", "STARTS", "MAX_NODES", "FREE_ANGLE"]
@@ -381,6 +381,7 @@ def _check_args(body, R, Theta, kind, F_max, beta_max, nodes, degree, guess, sta
     R = checks.number("R", R, positive=True, unit="m")
     Theta = checks.number("Theta", Theta, positive=True, unit="rad/s")
     checks.one_of("kind", kind, ("eight", "circle"))
+    checks.loop_domain(body, None, KINEMATICS[kind], [R], [Theta], heading_gains=False)  # before any solve
     F_max, beta_max = _check_limits(F_max, beta_max)
     nodes = checks.integer("nodes", nodes, minimum=8)
     if nodes > MAX_NODES:

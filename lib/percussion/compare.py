@@ -18,12 +18,13 @@ import pandas as pd
 from ..machinery import checks
 from ..angles import wrap_angle
 from ..params import Body
+from ..rotation.engine import check_domain
 from ..rotation.reduced import reduced_rotation, rotation_orbit
 from ..trajectories import make
 from .engine import HeadingEngine, coefficients
-from .point import centre_of_percussion, lateral_drag_speed
+from .point import _eps, _s_p
 from .sweep import heading_sweep
-from .zero_dynamics import heading_rate, path_drive
+from .zero_dynamics import _heading_rate, path_drive
 
 __all__ = ["SteadyMotion", "paper_steady", "percussion_steady", "steady_table", "path_distance"]
 
@@ -80,6 +81,10 @@ def paper_steady(body: Body, kind: str, R: float, Theta: float, *, transient: in
         If no orbit of period 1 of the reduced rotation is found.
     """
     R, Theta = _check(body, kind, R, Theta)
+    transient = checks.integer("transient", transient, minimum=1)
+    steps, record_steps = (checks.integer(n, v, minimum=8)
+                           for n, v in (("steps", steps), ("record_steps", record_steps)))
+    check_domain(body, kind, np.array([R]), np.array([Theta]))      # the verdicts' domain, before any run
     ref = make(kind, R, Theta)
     orb = rotation_orbit(body, kind, [R], [Theta], transient=transient, steps=steps)
     if not bool(np.all(orb.converged)):
@@ -136,12 +141,12 @@ def percussion_steady(body: Body, kind: str, R: float, Theta: float, *, steps: i
     p = wrap_angle(o["p"][0])
     phi = p + z[:, 2]
     w, dw = path_drive(body, ref, t)
-    dphi = heading_rate(body, phi, w)
+    dphi = _heading_rate(_eps(body), phi, w)
     e1 = np.stack([np.cos(phi), np.sin(phi)], -1)
     e2 = np.stack([-e1[:, 1], e1[:, 0]], -1)
     wa, dwl = (w * e1).sum(-1), (dw * e2).sum(-1)
-    ddphi = (dwl - wa * dphi) / lateral_drag_speed(body)
-    s = centre_of_percussion(body)
+    ddphi = (dwl - wa * dphi) / _eps(body)
+    s = _s_p(body)
     u1 = body.m * (wa + s * dphi**2)
     u2 = (body.I * ddphi + body.c_phi * dphi) / body.a
     return SteadyMotion(t=t, p=p, F=np.hypot(u1, u2), beta=np.arctan2(u2, u1), C=z[:, :2] - s * e1)

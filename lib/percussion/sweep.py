@@ -26,7 +26,7 @@ from ..rotation.verdicts import FIG5_GRID
 from ..dynamics.sampled import sampled_range
 from .engine import HeadingEngine, HeadingMap, coefficients
 
-__all__ = ["SWEEP_DEFAULTS", "heading_sweep", "percussion_fig5_map"]
+__all__ = ["SWEEP_DEFAULTS", "heading_sweep", "percussion_fig5_map", "rotation_sweep"]
 
 _DEFAULTS = dict(steps=128, transient=16, chunk=4, min_transient=4, max_period=4, lyapunov_periods=120, block=12,
                  newton_tol=1e-10, candidate_tol=0.05, reach_tol=0.05, reach_floor=1e-9, lyapunov_band=0.01,
@@ -46,9 +46,7 @@ def _check_domain(body: Body, kind: str, R, Theta, steps: int) -> None:
     eng = HeadingEngine(kind, 64)
     cA, cV = coefficients(body, R, Theta)
     rate = np.abs(cA) * np.hypot(eng.eX2, eng.eY2).max() + np.abs(cV) * np.hypot(eng.eX1, eng.eY1).max()
-    need = 2 * np.pi * rate / MAX_EXPONENT
-    by_r = checks.scale_culprit(body, R, Theta) == "R"
-    checks.within_budget({"R": np.where(by_r, need, 0), "Theta": np.where(by_r, 0, need)}, steps,
+    checks.within_budget(checks.by_scale(body, R, Theta, 2 * np.pi * rate / MAX_EXPONENT), steps,
                          what="a period would need", unit=f"Magnus steps (each step's exponent <= {MAX_EXPONENT:g})",
                          values={"R": (R, "m"), "Theta": (Theta, "rad/s")},
                          fix="raise the option steps, or keep R and Theta near the body's scales")

@@ -35,7 +35,7 @@ from ..machinery import checks
 from ..angles import wrap_angle
 from ..params import Body
 from ..trajectories import POSITIONS, Reference, _Path
-from .point import centre_of_percussion, lateral_drag_speed
+from .point import _eps, centre_of_percussion, lateral_drag_speed
 
 __all__ = ["path_drive", "heading_rate", "frozen_lock", "CircleSteadyMotion", "circle_steady_motion", "circle_slip",
            "circle_lock_radius", "zero_dynamics_run"]
@@ -88,8 +88,14 @@ def heading_rate(body: Body, phi, w) -> np.ndarray:
     numpy.ndarray
         phi' (rad/s).
     """
+    checks.instance("body", body, Body)
+    return _heading_rate(_eps(body), phi, w)
+
+
+def _heading_rate(eps: float, phi, w) -> np.ndarray:
+    """:func:`heading_rate`'s kernel for a checked body's eps (m/s), for inner loops."""
     w = np.asarray(w, float)
-    return (w[..., 1] * np.cos(phi) - w[..., 0] * np.sin(phi)) / lateral_drag_speed(body)
+    return (w[..., 1] * np.cos(phi) - w[..., 0] * np.sin(phi)) / eps
 
 
 def frozen_lock(body: Body, w, dpsi) -> dict:
@@ -223,11 +229,24 @@ def zero_dynamics_run(body: Body, ref: Reference, t, phi0: float, *, rtol: float
     numpy.ndarray
         phi at t.
     """
+    checks.instance("body", body, Body)
+    if not all(callable(getattr(ref, k, None)) for k in ("z", "dz", "ddz")):
+        raise TypeError(f"ref must be a reference with z, dz and ddz methods, got {type(ref).__name__}")
     t = checks.array("t", t, ndim=1, nonempty=True)
     phi0 = checks.number("phi0", phi0)
+    rtol, atol = checks.number("rtol", rtol, positive=True), checks.number("atol", atol, positive=True)
+    # the heading relaxes at up to (a_ref + (c/m) v) / |eps| (1/s): a stiff first-order equation,
+    # DOP853's steps about that rate times the span over 4 (the domain check, before any run)
+    speed, accel = checks.path_extremes(ref)
+    rate = (accel + body.c / body.m * speed) / abs(_eps(body))
+    name = f"ref (R = {ref.R:g} m, theta = {ref.theta:g} rad/s)" if hasattr(ref, "R") else "ref"
+    checks.within_budget({name: checks.run_steps(-rate, float(t[-1]))}, checks.MAX_ODE_STEPS,
+                         what="the run would need", unit="steps of DOP853", fix="a shorter t, or a smaller R Theta")
 
-    def rhs(tt, y):
-        return [heading_rate(body, y[0], path_drive(body, ref, tt)[0])]
+    eps = _eps(body)
+
+    def rhs(tt, y):                             # the kernels: body and ref were checked above
+        return [_heading_rate(eps, y[0], path_drive(body, ref, tt)[0])]
 
     sol = solve_ivp(rhs, (0.0, float(t[-1])), [phi0], method="DOP853", t_eval=t, rtol=rtol, atol=atol)
     return sol.y[0]

@@ -73,6 +73,9 @@ def circle_final_state(body: Body, R, theta, p0=0.0, v0=0.0, t_end: float = 300.
         One row per broadcast point: R, theta, p0, v0, p_end, v_end, t_end (s), regime.
     """
     R, theta, p0, v0 = _circle_arrays(body, R, theta, p0, v0)
+    t_end, t_max = (checks.number(n, v, positive=True, unit="s") for n, v in (("t_end", t_end), ("t_max", t_max)))
+    checks.path_budget(body, R, theta, t_max, names=("R", "theta"), limit=checks.MAX_ODE_STEPS,
+                       damping=False)
     N = R.size
     ps = np.full(N, np.nan)
     for i in range(N):
@@ -133,6 +136,9 @@ def circle_slipping_coexists(body: Body, R, theta, t_end: float = 400.0) -> np.n
         One bool per broadcast point.
     """
     R, theta = _circle_arrays(body, R, theta)
+    t_end = checks.number("t_end", t_end, positive=True, unit="s")
+    checks.path_budget(body, R, theta, t_end, names=("R", "theta"), limit=checks.MAX_ODE_STEPS,
+                       damping=False)
     N = R.size
     ps = np.empty(N)
     y0 = np.empty(2 * N)
@@ -199,6 +205,10 @@ def homoclinic_miss(body: Body, R: float, theta: float, rtol: float = 1e-10) -> 
         The signed miss (dimensionless): positive where the branch runs on past the next saddle.
     """
     p_s, p_u = circle_equilibria(body, R, theta)
+    rtol = checks.number("rtol", rtol, positive=True)
+    # the branch passes one saddle: about a period of the pendulum's own oscillation, well
+    # within 100 reference periods
+    checks.path_budget(body, R, theta, 200 * math.pi / theta, names=("R", "theta"), limit=checks.MAX_ODE_STEPS)
     if p_u < p_s:                              # the saddle just above p_s
         p_u += 2 * math.pi
     target = p_u - 2 * math.pi                 # the saddle just below p_s
@@ -337,9 +347,11 @@ def window_closing_rate(body: Body) -> float:
         th = math.exp(log_theta)
         return _linear_miss(body, circle_critical_radius(body, th) / k, th)
 
-    lo, hi = math.log(1e-3), math.log(1e3)
+    # up to the rotation's domain (lib.machinery.domain.heading_damping): 2 pi 8 c_phi / I_C, 71 times
+    # the closing rate c_phi / (I_C 1.19^2) of any body
+    lo, hi = math.log(1e-3), math.log(0.999 * 2 * math.pi * checks.MAX_DAMPING_PERIODS * body.c_phi / body.I)
     if not miss(lo) > 0.0 > miss(hi):
-        raise RuntimeError("the window does not close between Theta = 1e-3 and 1e3 rad/s")
+        raise RuntimeError(f"the window does not close between Theta = 1e-3 and {math.exp(hi):.4g} rad/s")
     return math.exp(brentq(miss, lo, hi, xtol=1e-12))
 
 

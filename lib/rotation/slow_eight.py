@@ -362,6 +362,12 @@ def slow_eight_prediction(body: Body, R, Theta, n_phase: int = 4096) -> SlowEigh
         raise ValueError(f"R and Theta must broadcast together, got shapes {R.shape} and {Th.shape}") from e
     shape = R.shape
     R, Th = R.ravel().copy(), Th.ravel().copy()
+    A, B, C = coefficients(body, R, Th)                # the domain before any run (issue 37)
+    checks.heading_damping(body, Th)
+    checks.within_budget(checks.by_scale(body, R, Th, 2 * np.pi * (B * np.sqrt(2.0) + C * np.sqrt(5.0)) / A / 0.25),
+                         checks.MAX_STEPS, what="a period would need", unit="RK4 steps",
+                         values={"R": (R, "m"), "Theta": (Th, "rad/s")},
+                         fix="outside the slow eights' domain (R far beyond the body's scale)")
     r_follow = follow_radius(body, Th, n_phase)
     k_max = r_follow / R
     follows = k_max <= 1.0
@@ -369,7 +375,6 @@ def slow_eight_prediction(body: Body, R, Theta, n_phase: int = 4096) -> SlowEigh
     fmin, fmax = p.min(axis=1), p.max(axis=1)
     n = _steps(body, R, Th)
     f, H = _forcing(n)
-    A, B, C = coefficients(body, R, Th)
     od, od_slips = _periodic_range(A, B, C, f, H, n, corrected=False)
     co, co_slips = _periodic_range(A, B, C, f, H, n, corrected=True)
 
