@@ -52,3 +52,16 @@ def test_limit_verdicts_returns_a_named_pair_that_still_unpacks():
     assert isinstance(out, LimitVerdicts)
     frame, runs = out                                   # the old unpacking
     assert frame is out.frame and runs is out.runs and len(frame) == 1
+
+
+def test_percussion_steady_checks_its_body_at_the_public_faces_only(monkeypatch):
+    # issue 37: following percussion_steady's body, it entered lib.machinery.checks 13 times (every
+    # layer, and twice in each of five eps); now at percussion_steady and at the sweep it runs
+    from lib.machinery import checks
+    from lib.percussion import compare
+    seen = []
+    real = checks.instance
+    monkeypatch.setattr(checks, "instance", lambda name, value, cls, what=None: (
+        seen.append(name) if isinstance(value, Body) else None) or real(name, value, cls, what))
+    compare.percussion_steady(BODY, "eight", 2.0, 0.5)
+    assert len(seen) == 2

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..params import Body
 from ..trajectories import KINEMATICS, POSITIONS
-from .point import lateral_drag_speed
+from .point import _eps
 
 __all__ = ["WINDING", "HeadingEngine", "HeadingMap", "coefficients"]
 
@@ -41,7 +41,8 @@ def coefficients(body: Body, R, Theta) -> tuple[np.ndarray, np.ndarray]:
     Parameters
     ----------
     body : Body
-        The body (its eps = :func:`lib.percussion.point.lateral_drag_speed` and k = c/m).
+        The body, checked by the caller (its eps = :func:`lib.percussion.point.lateral_drag_speed`
+        and k = c/m).
     R : array_like
         Sizes of the path (m).
     Theta : array_like
@@ -54,7 +55,7 @@ def coefficients(body: Body, R, Theta) -> tuple[np.ndarray, np.ndarray]:
     cV : numpy.ndarray
         R (c/m) / eps (dimensionless), the shape of ``R``.
     """
-    eps = lateral_drag_speed(body)
+    eps = _eps(body)                           # a checked body: the kernel, not the public face
     R, Theta = np.asarray(R, float), np.asarray(Theta, float)
     return R * Theta / eps, R * (body.c / body.m) / eps
 

@@ -19,6 +19,16 @@ __all__ = ["centre_of_percussion", "drag_mismatch", "lateral_drag_speed", "point
            "body_state_from_point"]
 
 
+def _s_p(body: Body) -> float:
+    """s_P (m) of a checked body: the kernel the public functions and the inner loops share."""
+    return -body.I / (body.m * body.a)
+
+
+def _eps(body: Body) -> float:
+    """eps (m/s) of a checked body (:func:`lateral_drag_speed`'s kernel, for inner loops)."""
+    return _s_p(body) * (body.c / body.m - body.c_phi / body.I)
+
+
 def centre_of_percussion(body: Body) -> float:
     """P's signed position on the body axis from C (m), positive towards the force's point of
     application (C + a e1): s_P = -I_C / (m a), on the far side of C from the force.
@@ -34,7 +44,7 @@ def centre_of_percussion(body: Body) -> float:
         s_P (m).
     """
     checks.instance("body", body, Body)
-    return -body.I / (body.m * body.a)
+    return _s_p(body)
 
 
 def drag_mismatch(body: Body) -> float:
@@ -69,7 +79,8 @@ def lateral_drag_speed(body: Body) -> float:
     float
         eps (m/s).
     """
-    return centre_of_percussion(body) * drag_mismatch(body)
+    checks.instance("body", body, Body)
+    return _eps(body)
 
 
 def point_state(body: Body, z, dz) -> tuple[np.ndarray, np.ndarray]:
