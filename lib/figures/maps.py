@@ -45,8 +45,9 @@ def _cells(R: np.ndarray, Th: np.ndarray):
 def plot_fig5(frame: pd.DataFrame, ax=None):
     """Fig. 5: range (rad) of the rotation error over the attracting orbit at the periodic
     points of a rectangular (R, Theta) grid (:func:`lib.rotation.verdicts.rotation_verdicts`), the
-    other regimes in flat colours (:data:`REGIME_COLORS`), and the points where stability
-    is lost (column ``lost``) ringed, as the paper's empty circles. Returns the figure.
+    other regimes in flat colours (:data:`REGIME_COLORS`), and the points whose heading is
+    lost (column ``lost``) ringed. The paper's empty circles compare with the points not held
+    (every colour but the periodic map's; Chapter 5), not with the rings. Returns the figure.
 
     Parameters
     ----------
