@@ -84,6 +84,9 @@ LABELS = {
         "s_P": ("m", "from C"), "eps": ("m/s", "drag"), "lock": ("m", "locks"), "crit": ("m", "(36)"),
         "rate": ("1/s", "rate"), "n_held": ("points", "held"), "n_grid": ("points", "grid"),
         "n_lost": ("points", "lost"), "n_chaotic": ("points", "chaotic"),
+        "lock_ratio": ("times", "lock radius"), "rho": ("", "drag rates' ratio"),
+        "fl_held_full": ("points", "full 7-state loop"), "fl_points": ("points", "sampled"),
+        "fl_held_zero": ("points", "zero dynamics"),
     },
     "chapters/08_optimal": {
         "b4_max": ("m", "lower bound"), "b4_max_ach": ("m", "motion"), "p4_max": ("m", "paper's law"),
