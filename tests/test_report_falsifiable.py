@@ -225,19 +225,26 @@ def test_weight_limit_row_fails_with_each_clause(monkeypatch, w, below, above, s
     (0.0, None, 0.5, "not reproducible"),          # the heading's rate not negative
 ])
 def test_percussion_circle_row_fails_with_each_clause(monkeypatch, radius_gap, lock, rate, status):
-    # the closed forms themselves (instant), each clause broken by a wrapper: a check that puts P
-    # on another circle, or asks at another rate or radius, is caught by the first case
-    real_motion, real_lock = ext.circle_steady_motion, ext.circle_lock_radius
+    # the closed forms themselves (instant), each clause broken by a wrapper; the check must ask
+    # Chapter 7's lib.percussion.claims.paper_circle_of_p about the paper's circle (R = 2 m,
+    # Theta = pi/4 rad/s): another rate is refused here, another radius also by the first case
+    real_circle, real_lock = ext.paper_circle_of_p, ext.circle_lock_radius
 
-    def motion(body, R, Theta):
-        st = real_motion(body, R, Theta)
-        return SimpleNamespace(radius_C=st.radius_C * (1 + radius_gap), rate=st.rate if rate is None else rate)
+    def circle_of_p(*args):
+        assert _same(args, (ext.Body(), 2.0, math.pi / 4)), args
+        R_P, st = real_circle(*args)
+        return R_P, SimpleNamespace(radius_C=st.radius_C * (1 + radius_gap), rate=st.rate if rate is None else rate)
 
     def lock_radius(body, th):
         return real_lock(body, th) if lock is None else lock * ext.circle_critical_radius(body, th)
 
-    assert _status(monkeypatch, "percussion-circle", circle_steady_motion=motion,
+    assert _status(monkeypatch, "percussion-circle", paper_circle_of_p=circle_of_p,
                    circle_lock_radius=lock_radius) == status
+
+
+def _full_loop(n_held=4):
+    """Chapter 7's full-loop verdicts on a 4-point sample, ``n_held`` of them held."""
+    return pd.DataFrame({"held": [True] * n_held + [False] * (4 - n_held)})
 
 
 @pytest.mark.parametrize("regime, lost, status", [
@@ -249,8 +256,31 @@ def test_percussion_circle_row_fails_with_each_clause(monkeypatch, radius_gap, l
 def test_percussion_map_row_fails_with_one_point_not_held(monkeypatch, regime, lost, status):
     fr = pd.DataFrame({"regime": ["periodic"] * 9 + [regime], "lost": [False] * 9 + [lost]})
     paper = pd.DataFrame({"regime": ["periodic"] * 7 + ["chaotic"] * 3, "lost": False, "turns_round": False})
-    got = _status(monkeypatch, "percussion-map", cached=_cache(percussion_fig5_map=fr, fig5_map=paper))
+    got = _status(monkeypatch, "percussion-map",
+                  cached=_cache(percussion_fig5_map=fr, fig5_map=paper, full_loop_verdicts=_full_loop()))
     assert got == status
+
+
+@pytest.mark.parametrize("n_held", [4, 3])
+def test_percussion_map_row_states_the_full_loop_sample_without_deciding_on_it(monkeypatch, n_held):
+    # the full loop is reported in the note, not a clause: the status follows the zero dynamics
+    fr = pd.DataFrame({"regime": ["periodic"] * 10, "lost": False})
+    paper = pd.DataFrame({"regime": ["periodic"] * 7 + ["chaotic"] * 3, "lost": False, "turns_round": False})
+    seen = []
+
+    def cache(fn, *args, **kw):
+        if fn.__name__ == "full_loop_verdicts":
+            seen.append(args)
+            return _full_loop(n_held)
+        return {"percussion_fig5_map": fr, "fig5_map": paper}[fn.__name__]
+
+    monkeypatch.setattr(ext, "cached", cache)
+    out = ITEMS["percussion-map"].check()
+    assert out.status == "extended"
+    assert f"holds the heading at {n_held} of its 4 points" in out.note
+    # Chapter 7's call, argument for argument, so the build's cache is shared
+    R_s, Th_s, _ = ext.grid_sample(10)
+    assert len(seen) == 1 and _same(seen[0], (ext.Body(), ext.Gains(), R_s, Th_s))
 
 
 @pytest.mark.parametrize("lost, not_held, undecided, status", [
