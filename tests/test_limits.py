@@ -328,7 +328,7 @@ def test_limit_verdicts_find_the_period_two_motion_at_60_degrees(perturb):
 
 def test_switched_runs_reject_bad_input():
     ref = T.eight()
-    with pytest.raises(ValueError, match="angle limit must be in"):
+    with pytest.raises(ValueError, match=r"angle_limits\[1\] must be in"):
         L.switched_runs(Body(), Gains(), ref, [0.5, 4.0], n_periods=1)
     with pytest.raises(ValueError, match="force limit"):
         L.switched_runs(Body(), Gains(), ref, 0.5, -1.0, n_periods=1)

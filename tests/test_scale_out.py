@@ -116,7 +116,7 @@ def test_limit_verdicts_through_a_process_pool_are_the_single_call(pool):
     for name in L.SwitchedRuns.__dataclass_fields__:
         a, b = getattr(got_runs, name), getattr(runs, name)
         assert np.array_equal(a, b, equal_nan=True), name
-    with pytest.raises(ValueError, match="angle limit"):                # checked here, before any chunk leaves
+    with pytest.raises(ValueError, match="angle_limits"):                # checked here, before any chunk leaves
         L.limit_verdicts(Body(), Gains(), ref, [0.5, 4.0], executor=pool, **o)
 
 
