@@ -22,6 +22,7 @@ from lib.weighting import batch as weighting_batch, comparison, verdicts as loop
 from lib.optimal import bound as optimal_bound, motion as optimal_motion, study as optimal_study
 from lib.percussion import compare as percussion_compare, zero_dynamics
 from lib.rotation import circle_global, slow_eight
+from lib.rotation.engine import check_domain
 
 B, G = Body(), Gains()
 R0, TH0 = 2.0, 0.5                      # a point inside every domain
@@ -126,16 +127,13 @@ def test_the_budget_names_the_argument_that_costs_most_at_the_first_point_over_i
 
 
 def test_the_book_s_own_runs_are_inside_the_budget():
-    # the paper's circle and eight over 40 periods, and Fig. 5's corners under both laws
+    # the paper's circle and eight over 40 periods, and Fig. 5's corners under both laws and both paths
     for ref in (T.circle(), T.eight()):
-        s, a = (np.hypot(*v[:, :2].T).max() for v in (ref.dz(np.linspace(0, ref.period, 257)),
-                                                       ref.ddz(np.linspace(0, ref.period, 257))))
-        modes = checks.loop_modes(B, G, speed=s, accel=a, heading_gains=False)
+        speed, accel = checks.path_extremes(ref)
+        modes = checks.loop_modes(B, G, speed=speed, accel=accel, heading_gains=False)
         assert max(checks.run_steps(m, 40 * ref.period) for m in modes.values()) < checks.MAX_RUN_STEPS / 2  # reason: a margin
     for R, Th in ((0.25, 0.05), (4.0, 0.05), (0.25, 1.5), (4.0, 1.5)):
         for kind in ("eight", "circle"):
-            stability.rotation_verdicts  # noqa: B018 - the import is the entry
-            from lib.rotation.engine import check_domain
             check_domain(B, kind, np.array([R]), np.array([Th]))
             percussion._check_domain(B, kind, np.array([R]), np.array([Th]), percussion.SWEEP_DEFAULTS["steps"])
             checks.loop_domain(B, G, T.KINEMATICS[kind], [R], [Th])
