@@ -83,7 +83,6 @@ def _refuted_by(key: str, merit: float, merit_label: str, note: str, evidence: b
 
 
 # ------------------------------------------------------------------ Sec. 2
-
 @lru_cache(maxsize=1)
 def _open_loop_deviations() -> dict[str, float]:
     _, runs = open_loop_comparison(Body(), OPEN_LOOP_HORIZON)
@@ -267,11 +266,9 @@ def _check_fig3() -> Outcome:
                    "the rotation problem is much more visible on the eight than on the circle")
 
 
-def _check_table() -> Outcome:
-    v = verdict("table-number")     # the linked row: the caption's number, a slip of notation
-    return Outcome(legend_status(v.corrected_holds), 1.0, "tables in the paper (captioned 'Table 5')",
-                   "the paper's only table, whose parameters every chapter uses; its caption's number is a slip "
-                   "of notation (errata row), which changes no computation", erratum="table-number")
+def _check_table() -> Outcome:  # the caption's number is a slip of notation (errata row): no computation changes
+    return Outcome(legend_status(verdict("table-number").corrected_holds), 1.0, "tables (captioned 'Table 5')",
+                   "the paper's only table; its caption's number is a slip of notation", erratum="table-number")
 
 
 def _check_fig4() -> Outcome:
