@@ -429,7 +429,7 @@ def compare_with_zero_dynamics(full: pd.DataFrame, zero: pd.DataFrame) -> dict:
     full : pandas.DataFrame
         :func:`full_loop_verdicts` at some points.
     zero : pandas.DataFrame
-        :func:`lib.percussion.rotation_sweep` at the same points, in the same order.
+        :func:`lib.percussion.heading_sweep` at the same points, in the same order.
 
     Returns
     -------
