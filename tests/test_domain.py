@@ -21,6 +21,7 @@ from lib.tracking import mismatch, runs as tracking
 from lib.weighting import batch as weighting_batch, comparison, verdicts as loop_verdicts
 from lib.optimal import bound as optimal_bound, motion as optimal_motion, study as optimal_study
 from lib.percussion import compare as percussion_compare, zero_dynamics
+from lib.percussion.run import simulate as p_simulate
 from lib.rotation import circle_global, slow_eight
 from lib.rotation.engine import check_domain
 
@@ -51,6 +52,7 @@ ENTRIES = [
     ("tracking.run", lambda R, Th, **o: tracking.run(B, G, "eight", R, Th, 1.0, **o), {"samples_per_period": 0}),
     ("eight_sensitivity", lambda R, Th, **o: tracking.eight_sensitivity(B, G, [R], [Th], **o), {"n_periods": -1.0}),
     ("simulate", lambda R, Th, **o: simulate(B, G, T.eight(R, Th), 8.0, **o), {"t_eval": [2.0, 1.0]}),
+    ("percussion.simulate", lambda R, Th, **o: p_simulate(B, G, T.eight(R, Th), 8.0, **o), {"thrust0": "x"}),
     ("limit_verdicts", lambda R, Th, **o: limits.limit_verdicts(B, G, T.eight(R, Th), [0.5], **o),
      {"locator": "guess"}),
     ("switched_runs", lambda R, Th, **o: limits.switched_runs(B, G, T.eight(R, Th), 0.5, **dict(dict(n_periods=1), **o)),
@@ -111,7 +113,10 @@ def test_a_rate_far_beyond_the_bodys_is_refused_at_once_naming_Theta(call, bad):
     (lambda: loop_verdicts.closed_loop_verdicts(B, G, "eight", [1.0], [1e9]), r"^Theta = 1e\+09 rad/s"),
     (lambda: simulate(Body(), Gains(kp=1e6), T.circle(), 8), r"^body and gains: .*method='Radau'"),
     (lambda: simulate(Body(), Gains(), T.circle(R=1e9), 8), r"^ref \(R = 1e\+09 m"),
-], ids=["P sweep R", "P sweep Theta", "loop verdicts Theta", "simulate kp", "simulate R"])
+    (lambda: p_simulate(Body(), Gains(kp=1e6), T.circle(), 8), r"^gains and pole: .*method='Radau'"),
+    (lambda: p_simulate(Body(), Gains(), T.circle(R=1e9), 8), r"^ref \(R = 1e\+09 m"),
+], ids=["P sweep R", "P sweep Theta", "loop verdicts Theta", "simulate kp", "simulate R", "P simulate kp",
+        "P simulate R"])
 def test_the_runs_issue_37_found_silent_are_refused_at_once(call, name):
     # each ran for minutes or returned nonsense (quasiperiodic, undecided and tracked, blew up at t = 0.053 s)
     _refused(call, name)

@@ -180,8 +180,6 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
         The limits, the sample times, the recorded states and errors, the final modes, the
     companion's log-growths and the event statistics (crossings, slides, time sliding).
     """
-    from ..integrators.switched_compiled import dop853_dense, run_periods  # numba compiles on first use
-
     _check_parts(body, gains, ref)
     b, f = _limits_arrays(angle_limits, force_limits)
     n_periods = checks.integer("n_periods", n_periods, minimum=1)
@@ -202,6 +200,8 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
     g = gains
     P = np.array([body.m, body.I, body.a, body.c, body.c_phi, g.kp[0], g.kp[1], g.kv[0], g.kv[1], ref.R, ref.theta,
                   k_slide, 0.0 if isinstance(ref, Circle) else 1.0])
+    from ..integrators.switched_compiled import dop853_dense, run_periods  # numba: imported once checked
+
     tab = dop853()
     T = ref.period
     # with S samples per period the kernel's "period" is T / S: the reference is T-periodic,
