@@ -2,7 +2,7 @@
 it (numba), for :mod:`lib.integrators.switched_compiled`.
 
 A step of an explicit Runge-Kutta method (8th-order Dormand-Prince by default) is taken
-over a fixed interval; if an event function changed sign over it (:func:`_fired`), the
+over a fixed interval; if an event function changed sign over it (``_fired``), the
 first event is located to ``T_TOL`` = 1e-11 s and the run lands just past it, so that no
 step straddles a switching or a kink. Two locators do that (``run_periods``'s ``dense``):
 
@@ -35,7 +35,7 @@ from .switched_field import N_EVENTS, _field
 
 __all__ = ["T_TOL"]
 
-#: events are bracketed to 1e-11 s: switchings and slide exits (a jump of the field) and kinks
+#: events are placed within 1e-11 s, switchings and slide exits (a jump of the field) and kinks
 #: (a jump of its derivative) alike. Kinks located to only 1e-8 s cost a factor 40 in the error
 #: of a chaotic run after two periods (measured 2.5e-6 against 6e-8 at 20 deg, 400 steps)
 T_TOL = 1e-11

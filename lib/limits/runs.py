@@ -74,8 +74,8 @@ class SwitchedRuns:
 
 #: steps of the compiled integrator per reference period (8th-order Dormand-Prince)
 STEPS_PER_PERIOD = 200
-#: how the compiled integrator locates events: on the step's dense output, then one real step
-#: (the default), or by real steps only (:mod:`lib.integrators.switched_events`)
+#: how the compiled integrator locates events, on the step's dense output then one real step
+#: (the default) or by real steps only (:mod:`lib.integrators.switched_events`)
 LOCATORS = ("dense", "bracket")
 
 

@@ -7,7 +7,7 @@ force cap, sliding on the angle limit), and a difference quotient is the derivat
 period map only when every companion meets the same switchings in the same order as the orbit
 (no saltation is then crossed differently; the map is smooth across the perturbation).
 :func:`switching_census` checks this on the runs themselves: the events the compiled integrator
-locates in each run (:attr:`lib.limits.runs.SwitchedRuns.locating`), and the mode each run is
+locates in each run (``locating`` of :class:`lib.limits.runs.SwitchedRuns`), and the mode each run is
 in at every step of the period (free, the angle clipped at +beta_max or -beta_max, the force
 capped), read from its state through (23) and (25)-(26) without limits.
 """
