@@ -65,3 +65,16 @@ def test_percussion_steady_checks_its_body_at_the_public_faces_only(monkeypatch)
         seen.append(name) if isinstance(value, Body) else None) or real(name, value, cls, what))
     compare.percussion_steady(BODY, "eight", 2.0, 0.5)
     assert len(seen) == 2
+
+
+def test_the_law_for_p_checks_its_body_once_a_run_not_every_step(monkeypatch):
+    # issue 37: the law's inner loop went through the public helpers, each checking the body again
+    # at every evaluation of the rates (thousands a run); now simulate checks it, the kernels do not
+    from lib.machinery import checks
+    from lib.percussion import run as prun
+    seen = []
+    real = checks.instance
+    monkeypatch.setattr(checks, "instance", lambda name, value, cls, what=None: (
+        seen.append(name) if isinstance(value, Body) else None) or real(name, value, cls, what))
+    res = prun.simulate(BODY, GAINS, trajectories.eight(), 2.0, thrust0=0.5)
+    assert res.t.size > 10 and len(seen) <= 4, len(seen)   # simulate and error_polynomial; measured 2

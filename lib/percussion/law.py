@@ -47,7 +47,7 @@ import numpy as np
 
 from ..machinery import checks
 from ..params import Body, Gains
-from .point import centre_of_percussion, lateral_drag_speed, point_accel, point_state
+from .point import _eps, _point_accel, _point_state, _s_p
 
 __all__ = ["DEFAULT_POLE", "ANTI_WINDUP_TIME", "error_polynomial", "law_inputs", "closed_loop_rates",
            "applied_force"]
@@ -87,7 +87,8 @@ def law_inputs(body: Body, coeffs: np.ndarray, ref_kin, z, dz, xi) -> tuple[np.n
     """The law's inputs (nu (N/s), u2 (N)) at the state (z, dz, xi), vectorised over (...).
 
     ``ref_kin`` = (P_d, P_d', P_d'', P_d''') each (..., 2); ``coeffs`` from
-    :func:`error_polynomial`. Unvalidated kernel.
+    :func:`error_polynomial`. The body is checked, the arrays are not: the closed loop's inner
+    loop (:func:`closed_loop_rates`) calls the unchecked kernel behind it.
 
     Parameters
     ----------
@@ -111,10 +112,16 @@ def law_inputs(body: Body, coeffs: np.ndarray, ref_kin, z, dz, xi) -> tuple[np.n
     u2 : numpy.ndarray
         The lateral force F sin beta (N), (...).
     """
-    s, eps, k, m = centre_of_percussion(body), lateral_drag_speed(body), body.c / body.m, body.m
+    checks.instance("body", body, Body)
+    return _law_inputs(body, coeffs, ref_kin, z, dz, xi)
+
+
+def _law_inputs(body: Body, coeffs, ref_kin, z, dz, xi):
+    """:func:`law_inputs` of a checked body (the closed loop's inner loop)."""
+    s, eps, k, m = _s_p(body), _eps(body), body.c / body.m, body.m
     phi, om = z[..., 2], dz[..., 2]
-    P, dP = point_state(body, z, dz)
-    ddP = point_accel(body, phi, om, dP, xi)
+    P, dP = _point_state(body, z, dz)
+    ddP = _point_accel(body, phi, om, dP, xi)
     Pd, dPd, ddPd, dddPd = ref_kin
     D = dddPd + coeffs[:, 0] * (ddPd - ddP) + coeffs[:, 1] * (dPd - dP) + coeffs[:, 2] * (Pd - P)
     c, sn = np.cos(phi), np.sin(phi)
@@ -189,7 +196,7 @@ def closed_loop_rates(body: Body, coeffs, ref_kin, y, limits=None, anti_windup=N
         Its angle from the body axis (rad), (...).
     """
     z, dz, xi = y[..., :3], y[..., 3:6], y[..., 6]
-    nu, u2 = law_inputs(body, coeffs, ref_kin, z, dz, xi)
+    nu, u2 = _law_inputs(body, coeffs, ref_kin, z, dz, xi)
     fc = None if limits is None else limits.force
     ac = None if limits is None else limits.angle
     F, beta = applied_force(xi, u2, fc, ac)
@@ -206,7 +213,7 @@ def closed_loop_rates(body: Body, coeffs, ref_kin, y, limits=None, anti_windup=N
             saturated |= np.abs(beta0) > ac
         om = dz[..., 2]
         dom_law = (body.a * u2 - body.c_phi * om) / body.I          # the law's omega'
-        s = centre_of_percussion(body)
+        s = _s_p(body)
         fix = body.m * 2 * s * om * (acc[..., 2] - dom_law) + (F * np.cos(beta) - xi) / anti_windup
         nu = nu + np.where(saturated, fix, 0.0)
     return np.concatenate([dz, acc, nu[..., None]], -1), F, beta

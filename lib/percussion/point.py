@@ -99,7 +99,13 @@ def point_state(body: Body, z, dz) -> tuple[np.ndarray, np.ndarray]:
     P, dP : numpy.ndarray
         (..., 2).
     """
-    s = centre_of_percussion(body)
+    checks.instance("body", body, Body)
+    return _point_state(body, z, dz)
+
+
+def _point_state(body: Body, z, dz) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`point_state` of a checked body (the law's inner loop)."""
+    s = _s_p(body)
     z, dz = np.asarray(z, float), np.asarray(dz, float)
     e1 = np.stack([np.cos(z[..., 2]), np.sin(z[..., 2])], -1)
     e2 = np.stack([-e1[..., 1], e1[..., 0]], -1)
@@ -126,7 +132,13 @@ def point_accel(body: Body, phi, omega, dP, u1) -> np.ndarray:
     numpy.ndarray
         (..., 2).
     """
-    s, eps = centre_of_percussion(body), lateral_drag_speed(body)
+    checks.instance("body", body, Body)
+    return _point_accel(body, phi, omega, dP, u1)
+
+
+def _point_accel(body: Body, phi, omega, dP, u1) -> np.ndarray:
+    """:func:`point_accel` of a checked body (the law's inner loop)."""
+    s, eps = _s_p(body), _eps(body)
     phi, omega, u1 = (np.asarray(v, float) for v in (phi, omega, u1))
     e1 = np.stack([np.cos(phi), np.sin(phi)], -1)
     e2 = np.stack([-e1[..., 1], e1[..., 0]], -1)
