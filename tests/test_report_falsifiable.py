@@ -19,16 +19,19 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from lib.paper import extensions as ext
+from lib.paper import extensions as ext, studies
 
 ITEMS = {i.key: i for i in ext.items()}
 
 
 def _status(monkeypatch, key, **fakes):
-    """The status of extension row ``key`` with the module names ``fakes`` replaced."""
+    """The status of extension row ``key`` with the module names ``fakes`` replaced, in the rows'
+    module and in lib.paper.studies (the chapters' shared calls, which the rows read)."""
     for name, value in fakes.items():
-        assert hasattr(ext, name), name          # a fake for a name the check no longer reads
-        monkeypatch.setattr(ext, name, value)
+        mods = [m for m in (ext, studies) if hasattr(m, name)]
+        assert mods, name                        # a fake for a name the check no longer reads
+        for m in mods:
+            monkeypatch.setattr(m, name, value)
     return ITEMS[key].check().status
 
 
@@ -275,11 +278,12 @@ def test_percussion_map_row_states_the_full_loop_sample_without_deciding_on_it(m
         return {"percussion_fig5_map": fr, "fig5_map": paper}[fn.__name__]
 
     monkeypatch.setattr(ext, "cached", cache)
+    monkeypatch.setattr(studies, "cached", cache)
     out = ITEMS["percussion-map"].check()
     assert out.status == "extended"
     assert f"holds the heading at {n_held} of its 4 points" in out.note
     # Chapter 7's call, argument for argument, so the build's cache is shared
-    R_s, Th_s, _ = ext.grid_sample(10)
+    R_s, Th_s, _ = studies.grid_sample(10)
     assert len(seen) == 1 and _same(seen[0], (ext.Body(), ext.Gains(), R_s, Th_s))
 
 
@@ -340,7 +344,7 @@ def _ch8_study(*, bound=0.1, achieved=0.1002, gap=1e-9, law_max=None, paper_rms=
 
 def _cached_study(st):
     def fake(fn, *args):
-        assert fn is ext.limits_study and _same(args, (ext.Body(), ext.Gains(), ext.R0, ext.THETA0)), args
+        assert fn is studies.limits_study and _same(args, (ext.Body(), ext.Gains(), ext.R0, ext.THETA0)), args
         return st
     return fake
 

@@ -19,14 +19,10 @@ from scipy import stats
 from ..machinery.cache import cached
 from ..rotation.circle import circle_critical_radius
 from ..rotation.circle_global import bistable_window, torque_pendulum_threshold, window_closing_rate
-from ..limits.attractors import (heading_offset_starts, lyapunov_horizons, mirror_defect, mirrored_start,
-                                 start_attractors)
-from ..tracking.mismatch import mismatch_study
+from ..limits.attractors import mirror_defect
 from ..dynamics.verdicts import ORBIT_REGIMES, SIGMAS, held
 from ..percussion import circle_lock_radius, percussion_fig5_map
 from ..percussion.claims import paper_circle_of_p
-from ..percussion.full_loop import full_loop_verdicts, grid_sample
-from ..optimal.compare import limits_study
 from ..optimal.motion import verify_motion
 from ..optimal.study import PAPER_CAP
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
@@ -35,12 +31,13 @@ from ..rotation.verdicts import VERDICT_DEFAULTS
 from ..rotation.slow_eight import slow_eight_prediction
 from ..trajectories import eight
 from ..weighting.circle import circle_steady_state, circle_weight_limit
+from . import studies
 from .outcomes import Item, Outcome, legend_status
 
 __all__ = ["items", "fig5_readings", "mirror_attractors", "lost_false_positives"]
 
 #: the paper's rate and radius (its Table; Chapter 3's choice for the eight)
-R0, THETA0 = 2.0, math.pi / 4
+R0, THETA0 = studies.R0, studies.THETA0
 
 
 def _check_window() -> Outcome:
@@ -163,7 +160,7 @@ def _check_slow_eights() -> Outcome:
 
 
 def _check_wrong_model() -> Outcome:
-    study = cached(mismatch_study, Body(), Gains(), R0, THETA0, transient=96)   # Chapter 3's call
+    study = studies.wrong_model(Body(), Gains())                               # Chapter 3's call
     runs, rank = study["map"], study["influence"]
     kept = bool(((runs.regime == "periodic") & ~runs.lost & ~runs.position_lost).all())
     lin = float(np.max(np.abs(runs.pos_max - runs.pos_linear)))
@@ -192,12 +189,7 @@ def mirror_attractors() -> tuple[pd.DataFrame, float]:
     angle_limit : float
         The angle limit (rad).
     """
-    body, gains = Body(), Gains()
-    ref, s0 = _chapter4_eight()
-    b = math.radians(90)
-    offsets = np.radians(np.arange(-180, 180, 30))      # Chapter 4's starts
-    starts = np.vstack([heading_offset_starts(offsets), mirrored_start(body, gains, ref, b, None, s0)])
-    return cached(start_attractors, body, gains, ref, b, None, starts), b
+    return studies.mirror_attractors(Body(), Gains(), 90, None), math.radians(90)
 
 
 def _check_mirror() -> Outcome:
@@ -218,9 +210,7 @@ def _check_mirror() -> Outcome:
 
 
 def _check_lyapunov() -> Outcome:
-    ref, _ = _chapter4_eight()
-    conv = cached(lyapunov_horizons, Body(), Gains(), ref, np.radians([30, 45]), None,
-                  [48, 120, 240, 480])                                       # Chapter 4's call
+    conv = studies.lyapunov_convergence(Body(), Gains())                     # Chapter 4's call
     worst, ok = 0.0, True
     longest = int(conv.horizon.max())
     for _, g in conv.groupby("angle_deg"):
@@ -251,8 +241,7 @@ def _check_percussion_circle() -> Outcome:
 def _check_percussion_map() -> Outcome:
     fr = cached(percussion_fig5_map, Body())                  # Chapter 7's map, shared with the chapter
     paper = fig5_readings(cached(fig5_map, Body()))           # Chapter 5's, the baseline
-    R_s, Th_s, _ = grid_sample(10)
-    full = cached(full_loop_verdicts, Body(), Gains(), R_s, Th_s)   # Chapter 7's sample, shared with it
+    full, _ = studies.full_loop_sample(Body(), Gains())     # Chapter 7's sample, shared with it
     share = float(held(fr.regime, fr.lost).mean())
     ok = share == 1.0 and not (fr.regime == "chaotic").any()    # Chapter 7: every point held
     return Outcome(legend_status(ok, extension=True), share,
@@ -266,7 +255,7 @@ def _check_percussion_map() -> Outcome:
 
 def _chapter8():
     """Chapter 8's comparison, shared with the chapter (its call, its arguments)."""
-    return cached(limits_study, Body(), Gains(), R0, THETA0)
+    return studies.limits_comparison(Body(), Gains())
 
 
 def _check_cap_bound() -> Outcome:

@@ -18,7 +18,6 @@ import numpy as np
 
 from ..limits.attractors import half_period_mirror
 from ..machinery.cache import cached
-from ..optimal.compare import limits_study
 from ..optimal.study import PAPER_CAP
 from ..params import Body, Gains
 from ..percussion import percussion_fig5_map
@@ -26,6 +25,7 @@ from ..rotation.circle_global import bistable_window
 from ..rotation.fig5 import fig5_map
 from ..simulate import OPEN_LOOP_HORIZON, open_loop_comparison
 from ..trajectories import eight
+from . import studies
 from .extensions import R0, THETA0, fig5_readings, mirror_attractors
 from .report import SWEEP_DEG, _angle_sweep, outcome
 
@@ -151,7 +151,7 @@ def front_page() -> dict[str, float]:
     free, capped = _angle_sweep(None), _angle_sweep(PAPER_CAP)
     lo, hi = cached(bistable_window, Body(), THETA0)                       # Chapter 5's call
     paper, p_law = fig5_readings(cached(fig5_map, Body())), fig5_readings(cached(percussion_fig5_map, Body()))
-    table = cached(limits_study, Body(), Gains(), R0, THETA0)["table"]           # Chapter 8's call
+    table = studies.limits_comparison(Body(), Gains())["table"]                # Chapter 8's call
     cap_only = table[(table.cap == PAPER_CAP) & table.angle_deg.isna()].set_index("law")
     out = {
         "fd_eq6_t": OPEN_LOOP_HORIZON, "fd_eq6_pos": pos, "fd_eq6_heading": heading, "fd_fig3": f["fig3"],

@@ -19,7 +19,6 @@ asserts that it decides the claimed one and that the claimed one is the legend's
 
 from __future__ import annotations
 
-import math
 import re
 from functools import lru_cache
 
@@ -31,23 +30,24 @@ from scipy.optimize import brentq, minimize_scalar
 from ..rotation.circle import (circle_critical_radius, circle_eigenvalues, circle_equilibria,
                                circle_jacobian, circle_rotation_rhs)
 from ..rotation.circle_global import circle_slipping_coexists
-from ..allocation import Limits, allocate_limited
+from ..allocation import allocate_limited
 from ..control import allocate, allocate_least_squares, error_dynamics_solution
 from ..controllability import free_lie_rank, paper_bracket_count
-from ..limits.torus import NS_ANGLE_DEG, NS_START_CAP, torus_birth
+from ..limits.torus import NS_ANGLE_DEG, NS_START_CAP
 from ..limits.verdicts import extend_undecided, limit_verdicts
 from ..model import f, generalized_force
 from ..params import Body, Gains
 from ..rotation.attractor import rotation_attractor
 from ..rotation.fig5 import fig5_map
 from ..rotation.equations import derive_rotation_equation
-from ..simulate import OPEN_LOOP_HORIZON, Integration, open_loop_comparison, simulate
+from ..simulate import OPEN_LOOP_HORIZON, open_loop_comparison
 from ..symbolic import derive_body_frame, rank_determinants
-from ..tracking.runs import run, steady_summary
+from ..tracking.runs import steady_summary
 from ..trajectories import circle, eight, eight_heading_fourier
 from ..machinery.cache import cached
 from .errata import rows, verdict
 from .extensions import fig5_readings, items as extension_items
+from . import studies
 from .outcomes import STATUSES, Item, Outcome, legend_status
 
 __all__ = ["Outcome", "Item", "items", "outcome", "table", "STATUSES", "equation_numbers", "errata_on"]
@@ -113,8 +113,7 @@ def _check_drift() -> Outcome:
 
 @lru_cache(maxsize=1)
 def _circle_run():
-    # Chapter 5's run on the paper's circle (computed once per book build, shared with the chapter)
-    return cached(simulate, Body(), Gains(), circle(2.0, np.pi / 4), 60.0)
+    return studies.circle_run(Body(), Gains())     # Chapter 5's run on the paper's circle, shared
 
 
 def _check_eq24() -> Outcome:
@@ -272,10 +271,9 @@ def _check_table() -> Outcome:  # the caption's number is a slip of notation (er
 
 
 def _check_fig4() -> Outcome:
-    # Chapter 4's run of Fig. 4 (computed once per book build, shared with the chapter): ten
-    # periods of the eight from the paper's start, sampled 200 times a period
-    res = cached(run, Body(), Gains(), "eight", 2.0, np.pi / 4, 10, limits=Limits(force=4.0),
-                 integration=Integration(rtol=1e-9, atol=1e-9))
+    # Chapter 4's run of Fig. 4, shared with the chapter: ten periods of the eight from the
+    # paper's start, sampled 200 times a period
+    res = studies.fig4_run(Body(), Gains())
     e = np.hypot(res.error[:, 0], res.error[:, 1])
     last, prev = e[-200:], e[-400:-200]
     amplitude, drift = float(last.max()), float(np.abs(last - prev).max())
@@ -285,13 +283,12 @@ def _check_fig4() -> Outcome:
                    "a non-zero periodic position error, as the paper says")
 
 
-#: Chapter 4's bifurcation sweep: every whole degree of the angle limit
-SWEEP_DEG = np.arange(10, 91)
+SWEEP_DEG = studies.SWEEP_DEG       # Chapter 4's bifurcation sweep, every whole degree
 
 
 def _angle_sweep(cap):
-    """Chapter 4's sweep over the angle limit on the eight, computed once per book build."""
-    return cached(limit_verdicts, Body(), Gains(), eight(), np.radians(SWEEP_DEG), cap)[0]
+    """Chapter 4's sweep over the angle limit on the eight, shared with the chapter."""
+    return studies.angle_sweep(Body(), Gains(), cap)
 
 
 def _check_chaos() -> Outcome:
@@ -319,7 +316,7 @@ def _check_quasi() -> Outcome:
     qp = extend_undecided(body, gains, ref, limit_verdicts(body, gains, ref, np.radians([37.0]), 6.0)[0]).iloc[0]
     with_cap = (qp.regime == "quasiperiodic" and abs(qp.lyapunov) * ref.period < 0.0075
                 and 3 * qp.lyapunov_stderr * ref.period < 0.0075 and qp.floquet > 1.1)
-    ns = cached(torus_birth, body, gains, ref, math.radians(NS_ANGLE_DEG), NS_START_CAP)
+    ns = studies.torus(body, gains)
     born = (ns.modulus_below < 1.0 < ns.modulus_above and ns.multiplier.imag > 0.1
             and abs(ns.circle_rotation - ns.rotation) < ns.circles[0].rotation_error
             and ns.force_limit < NS_START_CAP)
