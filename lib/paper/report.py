@@ -288,7 +288,7 @@ SWEEP_DEG = studies.SWEEP_DEG       # Chapter 4's bifurcation sweep, every whole
 
 def _angle_sweep(cap):
     """Chapter 4's sweep over the angle limit on the eight, shared with the chapter."""
-    return studies.angle_sweep(Body(), Gains(), cap)
+    return studies.angle_sweep(Body(), Gains(), cap)[0]
 
 
 def _check_chaos() -> Outcome:

@@ -60,7 +60,7 @@ def fig4_run(body: Body, gains: Gains):
                   integration=Integration(rtol=1e-9, atol=1e-9))
 
 
-def angle_sweep(body: Body, gains: Gains, cap) -> pd.DataFrame:
+def angle_sweep(body: Body, gains: Gains, cap):
     """Chapter 4's decided sweep over the angle limit (:data:`SWEEP_DEG`) on the eight.
 
     Parameters
@@ -72,10 +72,10 @@ def angle_sweep(body: Body, gains: Gains, cap) -> pd.DataFrame:
 
     Returns
     -------
-    pandas.DataFrame
-        :func:`lib.limits.verdicts.limit_verdicts`' frame.
+    LimitVerdicts
+        :func:`lib.limits.verdicts.limit_verdicts`' frame and runs.
     """
-    return cached(limit_verdicts, body, gains, eight(R0, THETA0), np.radians(SWEEP_DEG), cap)[0]
+    return cached(limit_verdicts, body, gains, eight(R0, THETA0), np.radians(SWEEP_DEG), cap)
 
 
 def torus(body: Body, gains: Gains):
