@@ -28,7 +28,7 @@ from .params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from .trajectories import Circle, Eight, Reference
 
 __all__ = ["SimulationError", "SimulationResult", "simulate", "Integration", "simulate_open_loop",
-           "open_loop_comparison", "OPEN_LOOP_FORMS", "DEFAULT_RTOL", "DEFAULT_ATOL"]
+           "open_loop_comparison", "OPEN_LOOP_FORMS", "DEFAULT_RTOL", "DEFAULT_ATOL", "run_budget"]
 
 #: the default tolerances of :class:`Integration`
 DEFAULT_RTOL = Integration.rtol
@@ -98,23 +98,50 @@ def _instance(name: str, value, cls):
 EXPLICIT_METHODS = ("RK23", "RK45", "DOP853")
 
 
-def _check_budget(body: Body, gains: Gains, ref, t_end: float, integration, allocation) -> None:
-    """Refuse an explicit run whose fastest mode (the gains', or the heading's driven by the path,
-    :func:`lib.machinery.domain.loop_modes`) would make it take more than
-    :data:`lib.machinery.domain.MAX_RUN_STEPS` steps, naming the argument and the fix."""
+def run_budget(body: Body, ref, t_end: float, integration, modes) -> None:
+    """Refuse, before any work, a run whose fastest mode would make an explicit method take more
+    than :data:`lib.machinery.domain.MAX_RUN_STEPS` steps, naming the argument that sets it and
+    the fix; on the book's paths, also a heading damped too slowly
+    (:func:`lib.machinery.domain.heading_damping`). The one check of :func:`simulate` and of the
+    law for P's run (:func:`lib.percussion.run.simulate`).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    ref : Reference
+        The path.
+    t_end : float
+        The run's end time (s).
+    integration : Integration
+        Its method and tolerances.
+    modes : callable
+        (the path's largest speed (m/s), acceleration (m/s^2)) -> dict of argument name -> the
+        fastest mode it sets (complex, 1/s), ``"ref"`` for the heading driven by the path.
+
+    Returns
+    -------
+    None
+    """
     if isinstance(ref, (Circle, Eight)):         # the book's paths: the heading's domain, as every sweep's
         checks.heading_damping(body, ref.theta, "ref.theta")
     if integration.method not in EXPLICIT_METHODS:
         return
-    speed, accel = checks.path_extremes(ref)
-    modes = checks.loop_modes(body, gains, speed=speed, accel=accel, heading_gains=allocation.law != "position")
+    found = modes(*checks.path_extremes(ref))
     named = {"ref": f"ref (R = {ref.R:g} m, theta = {ref.theta:g} rad/s)"} if isinstance(ref, (Circle, Eight)) else {}
-    need = {named.get(name, name): checks.run_steps(mode, t_end) for name, mode in modes.items()}
-    rate = max(abs(m) for m in modes.values())
+    need = {named.get(name, name): checks.run_steps(mode, t_end) for name, mode in found.items()}
+    rate = max(abs(m) for m in found.values())
     checks.within_budget(need, checks.MAX_RUN_STEPS, what="the run would need",
                          unit=f"steps of {integration.method} over t_end = {t_end:g} s (the closed loop's fastest "
                          f"rate, about {rate:.3g} 1/s)",
                          fix="use a stiff method, integration=Integration(method='Radau'), or a shorter t_end")
+
+
+def _check_budget(body: Body, gains: Gains, ref, t_end: float, integration, allocation) -> None:
+    """:func:`run_budget` with the modes of (23)-(24)'s error dynamics and of the heading driven
+    by the path (:func:`lib.machinery.domain.loop_modes`)."""
+    run_budget(body, ref, t_end, integration, lambda speed, accel: checks.loop_modes(
+        body, gains, speed=speed, accel=accel, heading_gains=allocation.law != "position"))
 
 
 def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz0=None, *,

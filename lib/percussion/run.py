@@ -11,8 +11,8 @@ from ..machinery import checks
 from ..allocation import Limits
 from ..integrators.smooth import Integration, SimulationError, integrate
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
-from ..simulate import DEFAULT_RATE, EXPLICIT_METHODS, SimulationResult
-from ..trajectories import Circle, Eight, Reference, position_kinematics
+from ..simulate import DEFAULT_RATE, SimulationResult, run_budget
+from ..trajectories import Reference, position_kinematics
 from .law import ANTI_WINDUP_TIME, DEFAULT_POLE, closed_loop_rates, error_polynomial
 from .point import point_accel, point_state
 
@@ -52,24 +52,11 @@ def reference_point_kinematics(ref: Reference, t) -> tuple:
 
 
 def _check_budget(body: Body, ref, coeffs, t_end: float, integration: Integration) -> None:
-    """Refuse, before any work, a run whose fastest mode would make an explicit method take more
-    than :data:`lib.machinery.domain.MAX_RUN_STEPS` steps (as :func:`lib.simulate.simulate`
-    does): P's error dynamics (the roots of ``coeffs``' polynomials, gains and pole) and the
-    heading driven by the path (:func:`lib.machinery.domain.loop_modes`), naming the argument."""
-    if isinstance(ref, (Circle, Eight)):
-        checks.heading_damping(body, ref.theta, "ref.theta")
-    if integration.method not in EXPLICIT_METHODS:
-        return
-    speed, accel = checks.path_extremes(ref)
+    """:func:`lib.simulate.run_budget` with P's error dynamics (the roots of ``coeffs``'
+    polynomials, gains and pole) and the heading driven by the path."""
     roots = np.concatenate([np.roots(np.r_[1.0, row]).astype(complex) for row in coeffs])
-    modes = {"gains and pole": roots[np.argmax(np.abs(roots))],
-             **checks.loop_modes(body, speed=speed, accel=accel)}
-    if isinstance(ref, (Circle, Eight)):
-        modes[f"ref (R = {ref.R:g} m, theta = {ref.theta:g} rad/s)"] = modes.pop("ref")
-    checks.within_budget({name: checks.run_steps(mode, t_end) for name, mode in modes.items()},
-                         checks.MAX_RUN_STEPS, what="the run would need",
-                         unit=f"steps of {integration.method} over t_end = {t_end:g} s",
-                         fix="use a stiff method, integration=Integration(method='Radau'), or a shorter t_end")
+    run_budget(body, ref, t_end, integration, lambda speed, accel: {
+        "gains and pole": roots[np.argmax(np.abs(roots))], **checks.loop_modes(body, speed=speed, accel=accel)})
 
 
 def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz0=None, *,
