@@ -18,6 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable
 
+import numba
 import numpy as np
 
 from .machinery import checks
@@ -307,73 +308,88 @@ def allocate_limited(tau, phi, body: Body, weights=(1.0, 1.0, 0.0),
 
 def _limited(tau, phi, body: Body, sw, limits: Limits):
     """The unvalidated kernel of :func:`allocate_limited`, for loops (``sw`` the square
-    roots of the weights)."""
+    roots of the weights): the problem by ``_ls_kernel``, its candidates by the compiled
+    ``_limited_rows``."""
     u_star, G, r, bb = _ls_kernel(tau, phi, body, sw)
-    fmax = np.inf if limits.force is None else limits.force
-    bmax = np.pi if limits.angle is None else limits.angle
+    fmax, bmax = (d if x is None else float(x) for x, d in ((limits.force, np.inf), (limits.angle, np.pi)))
     shape = np.broadcast_shapes(u_star.shape[:-1], G.shape[:-2], r.shape[:-1], bb.shape)
-    u_star = np.broadcast_to(u_star, shape + (2,)).reshape(-1, 2)
-    G = np.broadcast_to(G, shape + (2, 2)).reshape(-1, 2, 2)
-    r = np.broadcast_to(r, shape + (2,)).reshape(-1, 2)
-    bb = np.broadcast_to(bb, shape).reshape(-1)
-    F_star = np.hypot(u_star[:, 0], u_star[:, 1])
-    admissible = (F_star <= fmax) & ((F_star == 0) | (np.abs(np.arctan2(u_star[:, 1], u_star[:, 0])) <= bmax))
-    cands = [np.where(admissible[:, None], u_star, np.nan),  # the unconstrained optimum, if admissible
-             np.zeros_like(u_star)]                           # the corner at the origin
-    if bmax < np.pi:                                          # the two rays beta = +-bmax
-        for sign in (1.0, -1.0):
-            d = np.array([np.cos(bmax), sign * np.sin(bmax)])
-            dGd = np.einsum("i,nij,j->n", d, G, d)
-            rd = r @ d
-            # J(t d) = t^2 dGd - 2 t rd + |b|^2; dGd = 0 forces rd = 0 (J >= 0), so J is flat there
-            t = np.divide(rd, dGd, out=np.zeros_like(rd), where=dGd > 0)
-            cands.append(np.clip(t, 0.0, fmax)[:, None] * d)
-    if np.isfinite(fmax):                                     # the arc F = fmax
-        cands += _arc_minima(G, r, fmax, bmax)
-    C = np.stack(cands, axis=1)                               # (n, candidates, 2)
-    J = np.nan_to_num(residual(C, G[:, None], r[:, None], bb[:, None]), nan=np.inf)
-    u = C[np.arange(C.shape[0]), np.argmin(J, axis=1)]
-    F = np.hypot(u[:, 0], u[:, 1])
-    beta = np.where(F > 0, np.arctan2(u[:, 1], u[:, 0]), 0.0)
+    rows = [np.ascontiguousarray(np.broadcast_to(x, shape + x.shape[x.ndim - k:]).reshape((-1,) + x.shape[x.ndim - k:]),
+                                 dtype=float) for x, k in ((u_star, 1), (G, 2), (r, 1), (bb, 0))]
+    F, beta = _limited_rows(*rows, fmax, bmax, 129, 5)
     return F.reshape(shape), beta.reshape(shape)
 
 
-def _arc_minima(G, r, fmax: float, bmax: float, n_samples: int = 129, n_newton: int = 5) -> list[np.ndarray]:
-    """Points u = fmax (cos beta, sin beta), |beta| <= bmax, at the two best sampled local
-    minima of J along the arc, each refined by safeguarded Newton on dJ/dbeta = 0 inside the
-    bracket of its two neighbouring samples (bisection where Newton would leave it or J'' <= 0).
-    Along the arc J - |b|^2 = fmax^2 (A0 + A1 cos 2beta + A2 sin 2beta) - 2 fmax (r1 cos beta +
-    r2 sin beta), A0 = (G11 + G22) / 2, A1 = (G11 - G22) / 2, A2 = G12: a trigonometric
-    polynomial of degree 2, with at most two local minima. Newton converges quadratically from
-    a sample within one sample spacing (about 0.05 rad for bmax = pi): the error squares
-    at every step, so ``n_newton`` = 5 steps reach rounding; a Newton step that would leave the
-    bracket, or J'' <= 0, is replaced by a bisection. The sampling resolves two local minima
-    whose samples are separated by one with a higher J: minima about 0.14 rad apart or more
-    (measured to 5e-9 rad, tests/test_core_mutants.py); two closer ones may be found as one."""
+@numba.njit(cache=True)
+def _limited_rows(u_star, G, r, bb, fmax, bmax, n_samples, n_newton):  # pragma: no cover (compiled)
+    """(F, beta) row by row, as :func:`allocate_limited` states: the candidate of least J (a NaN
+    J, a state that has blown up, never wins; ties to the earlier) among the admissible
+    unconstrained optimum, the origin, the two rays and the arc's two points of ``_arc_pair``."""
+    n = u_star.shape[0]
+    F, beta, cands = np.empty(n), np.empty(n), np.empty((6, 2))
+    for q in range(n):
+        g, r1, r2 = G[q], r[q, 0], r[q, 1]
+
+        def quad(u1, u2):
+            return u1 * (g[0, 0] * u1 + g[0, 1] * u2) + u2 * (g[1, 0] * u1 + g[1, 1] * u2)
+        us1, us2 = u_star[q, 0], u_star[q, 1]
+        fs = np.hypot(us1, us2)
+        ok = fs <= fmax and (fs == 0 or abs(np.arctan2(us2, us1)) <= bmax)
+        cands[0], cands[1], m = (us1, us2) if ok else (np.nan, np.nan), (0.0, 0.0), 2
+        if bmax < np.pi:
+            for d1, d2 in ((np.cos(bmax), np.sin(bmax)), (np.cos(bmax), -np.sin(bmax))):
+                dGd = quad(d1, d2)
+                t = min(max((r1 * d1 + r2 * d2) / dGd if dGd > 0 else 0.0, 0.0), fmax)
+                cands[m], m = (t * d1, t * d2), m + 1
+        if np.isfinite(fmax):
+            for b in _arc_pair(g, r[q], fmax, bmax, n_samples, n_newton):
+                cands[m], m = (fmax * np.cos(b), fmax * np.sin(b)), m + 1
+        win, least = 0, np.inf
+        for i in range(m):
+            v = quad(cands[i, 0], cands[i, 1]) - 2 * (r1 * cands[i, 0] + r2 * cands[i, 1]) + bb[q]
+            if v < least:                              # False for NaN
+                win, least = i, v
+        F[q] = np.hypot(cands[win, 0], cands[win, 1])
+        beta[q] = np.arctan2(cands[win, 1], cands[win, 0]) if F[q] > 0 else 0.0
+    return F, beta
+
+
+@numba.njit(cache=True)
+def _arc_pair(G, r, fmax, bmax, n_samples, n_newton):  # pragma: no cover (compiled)
+    """The angles (2,) of the two best sampled local minima of J on the arc u = fmax (cos beta,
+    sin beta), |beta| <= bmax (the least J first, ties to the lower angle; G (2, 2), r (2,)),
+    each refined by safeguarded Newton on dJ/dbeta = 0 inside the bracket of its two
+    neighbouring samples (bisection where Newton would leave it or J'' <= 0). Along the arc
+    J - |b|^2 = fmax^2 (A0 + A1 cos 2beta + A2 sin 2beta) - 2 fmax (r1 cos beta + r2 sin beta),
+    A1 = (G11 - G22) / 2, A2 = G12: at most two local minima. Newton from a sample within one
+    spacing (about 0.05 rad for bmax = pi) squares its error at every step, so 5 steps reach
+    rounding; the sampling separates minima about 0.14 rad apart or more (measured to 5e-9 rad,
+    tests/test_core_mutants.py); two closer ones may be found as one."""
     betas = np.linspace(-bmax, bmax, n_samples)
-    E = np.stack([np.cos(betas), np.sin(betas)], axis=-1) * fmax
-    J = np.einsum("mi,nij,mj->nm", E, G, E) - 2 * r @ E.T                   # (n, samples)
-    Jp = np.pad(J, ((0, 0), (1, 1)), constant_values=np.inf)
-    local = (J <= Jp[:, :-2]) & (J <= Jp[:, 2:])
-    ranked = np.argsort(np.where(local, J, np.inf), axis=1, kind="stable")[:, :2]   # (n, 2)
-    h = betas[1] - betas[0]
-    f2, f1 = fmax * fmax, fmax
-    A1 = (0.5 * (G[:, 0, 0] - G[:, 1, 1]))[:, None]
-    A2 = G[:, 0, 1][:, None]
-    r1, r2 = r[:, 0][:, None], r[:, 1][:, None]
-    beta = betas[ranked]
-    lo, hi = np.maximum(beta - h, -bmax), np.minimum(beta + h, bmax)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    h, Js, best = betas[1] - betas[0], np.empty(n_samples), np.full(2, -1)
+    for k in range(n_samples):
+        e1, e2 = fmax * np.cos(betas[k]), fmax * np.sin(betas[k])
+        Js[k] = e1 * (G[0, 0] * e1 + G[0, 1] * e2) + e2 * (G[1, 0] * e1 + G[1, 1] * e2) - 2 * (r[0] * e1 + r[1] * e2)
+    for pick in range(2):                              # the least local minimum, then the next
+        val = np.inf
+        for k in range(n_samples):
+            local = (k == 0 or Js[k] <= Js[k - 1]) and (k == n_samples - 1 or Js[k] <= Js[k + 1])
+            v = Js[k] if local else np.inf
+            if k != best[0] and (v < val or best[pick] < 0):
+                best[pick], val = k, v
+    A1, A2, out = 0.5 * (G[0, 0] - G[1, 1]), G[0, 1], betas[best]
+    for j in range(2):
+        b = out[j]
+        lo, hi = max(b - h, -bmax), min(b + h, bmax)
         for _ in range(n_newton):
-            c, s = np.cos(beta), np.sin(beta)
+            c, s = np.cos(b), np.sin(b)
             c2, s2 = c * c - s * s, 2 * s * c
-            d1 = 2 * f2 * (A2 * c2 - A1 * s2) - 2 * f1 * (r2 * c - r1 * s)
-            d2 = -4 * f2 * (A1 * c2 + A2 * s2) + 2 * f1 * (r1 * c + r2 * s)
-            lo, hi = np.where(d1 < 0, beta, lo), np.where(d1 > 0, beta, hi)
-            step = beta - d1 / d2
-            ok = (d2 > 0) & (step >= lo) & (step <= hi)
-            beta = np.where(ok, step, 0.5 * (lo + hi))
-    return [np.stack([np.cos(beta[:, j]), np.sin(beta[:, j])], axis=-1) * fmax for j in range(2)]
+            j1 = 2 * fmax ** 2 * (A2 * c2 - A1 * s2) - 2 * fmax * (r[1] * c - r[0] * s)
+            j2 = -4 * fmax ** 2 * (A1 * c2 + A2 * s2) + 2 * fmax * (r[0] * c + r[1] * s)
+            lo, hi = b if j1 < 0 else lo, b if j1 > 0 else hi
+            step = b - j1 / j2 if j2 > 0 else np.nan
+            b = step if lo <= step <= hi else 0.5 * (lo + hi)
+        out[j] = b
+    return out
 
 
 def allocate_least_squares(tau, phi, body: Body, weights=(1.0, 1.0, 0.0),
@@ -439,8 +455,6 @@ def _weighted(tau, phi, body: Body, sw, limits: Limits):
     F = np.hypot(u[..., 0], u[..., 1])
     beta = np.where(F > 0, np.arctan2(u[..., 1], u[..., 0]), 0.0)
     return limits.apply(F, beta)
-
-
 
 
 Allocator = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]

@@ -491,7 +491,7 @@ def _arc_reference_minima(G, r, f, bmax, n=20_001):
     """The two lowest local minima of J(beta) = f^2 u^T G u - 2 f r^T u, u = (cos beta,
     sin beta), on [-bmax, bmax], an end counting where J rises into the arc: sign changes - to
     + of dJ/dbeta on a dense grid, each refined by Brent's method (an independent route to what
-    _arc_minima's sampling and Newton find)."""
+    _arc_pair's sampling and Newton find)."""
     from scipy.optimize import brentq
     A1, A2 = 0.5 * (G[0, 0] - G[1, 1]), G[0, 1]
 
@@ -510,14 +510,14 @@ def _arc_reference_minima(G, r, f, bmax, n=20_001):
     return np.sort(sorted(minima, key=J)[:2])
 
 
-def test_arc_minima_finds_the_two_best_local_minima_of_the_arc_even_when_close():
+def test_arc_pair_finds_the_two_best_local_minima_of_the_arc_even_when_close():
     # J along the arc |u| = f is a trigonometric polynomial of degree 2: at most two local
     # minima inside, and an end of the arc is one where J rises into it. Here: two minima at
     # about centre +- b0, equal in value (tilt 0) or not (tilt 0.2), b0 down to 0.07 rad (1.4
     # sample spacings of the 129-sample search over bmax = pi; with a tilt from 0.1 rad: a
     # shallow minimum within about a spacing of the maximum beside it is below the search's
     # resolution, as its docstring says), at three curvature scales (J'' at the minima from
-    # 2e-5 to 18), over the whole circle and under an angle limit of 2.5 rad. _arc_minima must
+    # 2e-5 to 18), over the whole circle and under an angle limit of 2.5 rad. _arc_pair must
     # return the two best, each to 5e-8 rad (measured 4.9e-9 at b0 = 0.1 with the tilt, where
     # Newton's 5 steps start from a sample with J'' small; 5e-15 at b0 >= 0.2). Coarser
     # sampling, a wider bracket, a local-minimum test with `or`, or Newton only where J'' > 1
@@ -536,8 +536,6 @@ def test_arc_minima_finds_the_two_best_local_minima_of_the_arc_even_when_close()
                     + tilt * f * alpha * np.sin(b0) ** 3 * np.stack([-np.sin(centres), np.cos(centres)], -1)
                 if wants is None:
                     wants = np.array([_arc_reference_minima(Gi, ri, f, bmax) for Gi, ri in zip(G, r)])
-                p1, p2 = A._arc_minima(G, r, f, bmax)
-                np.testing.assert_allclose(np.hypot(p1[:, 0], p1[:, 1]), f, rtol=1e-15)  # exact: a point put on the arc by construction; reason: on the arc by construction, rounding only
-                got = np.sort(np.stack([np.arctan2(p1[:, 1], p1[:, 0]), np.arctan2(p2[:, 1], p2[:, 0])], -1), -1)
+                got = np.sort([A._arc_pair(Gi, ri, f, bmax, 129, 5) for Gi, ri in zip(G, r)], -1)
                 worst = max(worst, np.max(np.abs(got - wants)))
     assert worst < 5e-8, worst   # measured 4.9e-9 (b0 = 0.1, tilt 0.2)
