@@ -324,20 +324,33 @@ def _monodromy_multipliers(lqr: PeriodicLQR) -> np.ndarray:
     return floquet_multipliers(Y.reshape(6, 6))
 
 
-def _loop_inputs(lqr: PeriodicLQR, t, X, F_max, beta_max, t_in=None):
-    """Applied (F, beta) of the clipped loop at time(s) t for states X (..., 6)."""
-    xs, us = _reference(lqr.motion, t, t_in)
-    K = lqr._gain(t, xs, us)
+def _loop_inputs(lqr: PeriodicLQR, t, X, F_max, beta_max, t_in=None, ref=None):
+    """Applied (F, beta) of the clipped loop at time(s) t for states X (..., 6); ``ref`` the
+    motion's (x*, u*, K) there if known."""
+    xs, us, K = _loop_reference(lqr, t, t_in) if ref is None else ref
     U = us - np.einsum("...ij,...j->...i", K, X - xs)
     return _saturate(U[..., 0], U[..., 1], F_max, beta_max)
 
 
-def _loop(lqr: PeriodicLQR, F_max, beta_max, rows: int):
-    """The closed loop's rates on an input piece [lo, hi], ``rows`` states in one flat vector."""
+def _loop_reference(lqr: PeriodicLQR, t, t_in=None):
+    """(x*, u*, K) of the loop at time(s) t (inputs at ``t_in``)."""
+    xs, us = _reference(lqr.motion, t, t_in)
+    return xs, us, lqr._gain(t, xs, us)
+
+
+def _loop(lqr: PeriodicLQR, F_max, beta_max, rows: int, memo: dict | None = None):
+    """The closed loop's rates on an input piece [lo, hi], ``rows`` states in one flat vector.
+    ``memo``, for fixed steps that meet the same times again: (t, lo, hi) -> (x*, u*, K), which
+    depend on the time alone."""
     def piece(lo, hi):
         def rhs(t, s):
             X = s.reshape(rows, 6)
-            F, beta = _loop_inputs(lqr, t, X, F_max, beta_max, _inside(t, lo, hi))
+            ref = None if memo is None else memo.get((t, lo, hi))
+            if ref is None:
+                ref = _loop_reference(lqr, t, _inside(t, lo, hi))
+                if memo is not None:
+                    memo[t, lo, hi] = ref
+            F, beta = _loop_inputs(lqr, t, X, F_max, beta_max, ref=ref)
             out = np.concatenate([X[:, 3:], config_accel(lqr.body, X[:, :3], X[:, 3:], F, beta)], -1).ravel()
             if not np.all(np.isfinite(out)):
                 raise SimulationError(f"closed loop became non-finite at t = {t:.6g} s")

@@ -52,12 +52,14 @@ def _period_map(lqr: PeriodicLQR, F_max, beta_max, steps: int = 0):
     in the frame of t = 0, so the motion is a fixed point. ``steps`` > 0: classical RK4 with that
     many fixed steps on each input piece, all rows at once (no step straddles an input jump)."""
     shift, edges = 2 * np.pi * lqr.motion.turns * np.eye(6)[2], _edges(lqr.motion, 0.0, lqr.motion.period)
+    memo = {}     # every call meets the same stage times: the motion and its gain there, once
 
     def fixed(X):
         y = X.ravel()
         try:
             for a, b in zip(edges[:-1], edges[1:]):
-                y = integrate(_loop(lqr, F_max, beta_max, X.shape[0])(a, b), y, a, b, (b - a) / steps, RK4)[1][-1]
+                y = integrate(_loop(lqr, F_max, beta_max, X.shape[0], memo)(a, b), y, a, b, (b - a) / steps,
+                              RK4)[1][-1]
         except FloatingPointError as err:
             raise SimulationError(f"the period map blew up: {err}") from None
         return y.reshape(X.shape)
