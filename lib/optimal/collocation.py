@@ -65,8 +65,11 @@ class Tableau:
 
     def weights(self, s) -> np.ndarray:
         """The Lagrange basis at s in [0, 1] (any shape): shape s.shape + (d + 1,)."""
-        s = np.asarray(s, dtype=float)
-        return np.stack([np.polyval(b, s) for b in self.basis], axis=-1)
+        s = np.asarray(s, dtype=float)[..., None]
+        w = np.zeros(s.shape[:-1] + (self.basis.shape[0],))
+        for c in self.basis.T:             # Horner on every basis polynomial at once, as numpy.polyval
+            w = w * s + c
+        return w
 
 
 @lru_cache(maxsize=8)

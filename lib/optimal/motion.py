@@ -127,8 +127,8 @@ class PeriodicMotion:
         laps = np.floor(t / self.period)
         x = (t - laps * self.period) * (self.nodes / self.period)
         # a node time computed in floating point belongs to the interval it starts
-        k = np.clip(np.floor(x + NODE_SNAP).astype(int), 0, self.nodes - 1)
-        return k, np.clip(x - k, 0.0, 1.0), laps
+        k = np.minimum(np.maximum(np.floor(x + NODE_SNAP).astype(int), 0), self.nodes - 1)
+        return k, np.minimum(np.maximum(x - k, 0.0), 1.0), laps
 
     def inputs(self, t) -> tuple[np.ndarray, np.ndarray]:
         """The piecewise-constant inputs at times t (s), any shape, periodic in t.
