@@ -160,3 +160,20 @@ def test_pages_are_executed_longest_first_and_the_readers_of_other_pages_last():
     assert set(pages) == md
     ran = order(pages)
     assert sorted(ran) == sorted(pages) and ran[-len(LAST):] == list(LAST)
+
+
+def test_kernels_run_numba_on_one_thread_only_when_the_pages_fill_the_cores(monkeypatch):
+    """``tools/preexecute.py``'s kernel environment: BLAS on one thread always; numba on one
+    thread when as many pages run at once as there are cores, its own threads otherwise, and a
+    thread count the user set is kept."""
+    import sys
+
+    sys.path.insert(0, str(ROOT / "tools"))
+    from preexecute import kernel_env
+
+    monkeypatch.delenv("NUMBA_NUM_THREADS", raising=False)
+    assert kernel_env(2, 2) == {"OPENBLAS_NUM_THREADS": "1", "NUMBA_NUM_THREADS": "1"}
+    assert kernel_env(4, 2)["NUMBA_NUM_THREADS"] == "1"
+    assert kernel_env(1, 2) == {"OPENBLAS_NUM_THREADS": "1"}
+    monkeypatch.setenv("NUMBA_NUM_THREADS", "2")
+    assert "NUMBA_NUM_THREADS" not in kernel_env(2, 2)

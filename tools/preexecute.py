@@ -36,14 +36,44 @@ LAST = ("errata", "report", "intro")
 #: the kernels' environment: BLAS single-threaded. The book's matrices are small (2 x 2 to
 #: 6 x 6, stacks of them), so OpenBLAS's threads only spin: measured, Chapter 3's check of (24)
 #: (scipy's expm on a stack of 2 x 2 matrices) took 0.72 s of CPU with them and 0.08 s without,
-#: on a loaded machine. numba keeps its threads (its kernels are the pages' heavy work); they
-#: sleep while they wait (OMP_WAIT_POLICY=PASSIVE, set by lib/__init__.py), so that two pages'
-#: kernels do not spin against each other (measured: Chapter 5 took 96 s of CPU instead of 176).
+#: on a loaded machine. numba's threads sleep while they wait (OMP_WAIT_POLICY=PASSIVE, set by
+#: lib/__init__.py), so that two pages' kernels do not spin against each other (measured: Chapter
+#: 5 took 96 s of CPU instead of 176). When as many pages run at once as there are cores, each
+#: page's numba kernels run on one thread (:func:`kernel_env`): the cores are busy with pages
+#: already, and a second thread only adds its wake-ups and its share of small loops (measured on
+#: 2 cores, 2026-11-26: Fig. 5's map 60 s of CPU on one thread, 70 s on two; Chapter 4 118 s
+#: instead of 127). Each point of a parallel loop is computed alone, so the results do not
+#: depend on the threads (``make test-portable`` runs the tests on one).
 KERNEL_ENV = {"OPENBLAS_NUM_THREADS": "1"}
-#: a page's CPU time (s), measured, to start the longest first (unknown pages first of all)
-COST = {"chapters/04_limits": 167, "chapters/05_stability": 96, "chapters/03_tracking": 41,
-        "chapters/06_allocation": 31, "chapters/07_percussion": 8, "chapters/02_controllability": 10,
-        "chapters/01_model": 3, "methods": 1, "chapters/08_optimal": 140}
+#: a page's CPU time (s), measured (``make book-times``, 2026-11-26), to start the longest first
+#: (unknown pages first of all)
+COST = {"chapters/04_limits": 118, "chapters/05_stability": 90, "chapters/03_tracking": 61,
+        "chapters/06_allocation": 30, "chapters/07_percussion": 16, "chapters/02_controllability": 10,
+        "chapters/01_model": 3, "methods": 1, "chapters/08_optimal": 95}
+
+
+def kernel_env(jobs: int, cores: int | None = None) -> dict:
+    """The kernels' environment for ``jobs`` pages at once on ``cores`` (default: this machine's):
+    :data:`KERNEL_ENV`, and numba on one thread when the pages fill the cores (a variable the user
+    set is kept).
+
+    Parameters
+    ----------
+    jobs : int
+        Pages executed at once.
+    cores : int, optional
+        Cores available; default ``os.cpu_count()``.
+
+    Returns
+    -------
+    dict
+        Environment variables to set.
+    """
+    cores = (os.cpu_count() or 1) if cores is None else cores
+    env = dict(KERNEL_ENV)
+    if jobs >= cores and "NUMBA_NUM_THREADS" not in os.environ:
+        env["NUMBA_NUM_THREADS"] = "1"
+    return env
 
 
 def _config(root: Path) -> dict:
@@ -125,7 +155,7 @@ def main(argv: list[str] | None = None) -> int:
     from jupyter_cache.base import CacheBundleIn
 
     root = args.root.resolve()
-    os.environ.update(KERNEL_ENV)                         # inherited by the workers' kernels
+    os.environ.update(kernel_env(args.jobs))              # inherited by the workers' kernels
     execute = _config(root).get("execute", {})
     path = root / execute.get("cache", "_build/.jupyter_cache")
     shutil.rmtree(path, ignore_errors=True)               # nothing from an earlier build
