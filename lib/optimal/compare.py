@@ -88,7 +88,9 @@ def law_loop(body: Body, gains: Gains, ref, law: str, limits: Limits) -> LawLoop
     position = POSITIONS[ref._kind]
 
     def kin(t):
-        k = np.stack(np.broadcast_arrays(*position(ref.R, ref.theta, np.asarray(t, dtype=float))), -1)
+        t = np.asarray(t, dtype=float)
+        p = position(ref.R, ref.theta, t)
+        k = np.array(p) if t.ndim == 0 else np.stack(np.broadcast_arrays(*p), -1)   # one time: no broadcast
         return tuple(k[..., 2 * j:2 * j + 2] for j in range(4))
 
     def both(t, s):
