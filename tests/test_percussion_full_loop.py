@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -49,6 +50,41 @@ def test_the_compiled_field_is_the_law_for_p_of_lib_percussion_law(model):
         # accuracy: the same formulas in another order; omega' = r2 / eps (eps = 0.0875 m/s) and
         # nu multiply the rounding of the O(10) terms by up to about 100
         np.testing.assert_allclose(got, want, rtol=1e-10, atol=1e-10)
+
+
+@pytest.mark.parametrize("kind", ["eight", "circle"])
+@pytest.mark.parametrize("force, angle_deg", [(None, None), (4.0, None), (None, 30.0), (2.0, 45.0), (0.5, 12.0)])
+@pytest.mark.parametrize("anti_windup", [None, 0.5])
+def test_the_limited_compiled_field_is_the_law_for_p_under_limits(kind, force, angle_deg, anti_windup):
+    # Chapter 8's fixed-step loops run the law for P under limits on the compiled field: it must be
+    # lib.percussion.law's closed loop, clipping and anti-windup included, at states where the
+    # law's force is far above the cap and its angle beyond the limit as well as below them
+    from lib.allocation import Limits
+
+    rng = np.random.default_rng(11)
+    ref = trajectories.make(kind, 2.0, TH0)
+    co = error_polynomial(BODY, GAINS)
+    limits = Limits(force, None if angle_deg is None else math.radians(angle_deg))
+    field = fl.limited_field(BODY, GAINS, ref, limits, anti_windup)
+    position = trajectories.POSITIONS[kind]
+    clipped = 0
+    for _ in range(20):
+        t, Y = rng.uniform(0, 20), rng.normal(size=(4, 7)) * [1, 1, 3, 1, 1, 2, 3]
+        k = np.array(position(ref.R, ref.theta, t))
+        want, F, beta = closed_loop_rates(BODY, co, (k[0:2], k[2:4], k[4:6], k[6:8]), Y, limits, anti_windup)
+        if force is not None:
+            clipped += int(np.sum(F >= force))                  # exact: the cap is applied by min(F, cap)
+        if angle_deg is not None:
+            clipped += int(np.sum(np.abs(beta) >= math.radians(angle_deg)))   # exact: clipped by clip
+        # accuracy: the same formulas in another order (F cos(phi + beta) against xi cos phi - u2 sin phi
+        # where unclipped); omega' = r2 / eps and nu multiply the rounding of O(10) terms by about 100
+        np.testing.assert_allclose(field(t, Y), want, rtol=1e-10, atol=1e-10)
+    assert clipped > 0 or (force is None and angle_deg is None)
+
+
+def test_the_limited_compiled_field_refuses_a_path_it_does_not_know():
+    with pytest.raises(ValueError, match="kind"):
+        fl.limited_field(BODY, GAINS, SimpleNamespace(_kind="ellipse", R=2.0, theta=TH0))
 
 
 def test_the_grid_sample_spreads_over_fig5_grid_corners_included():

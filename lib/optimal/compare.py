@@ -27,6 +27,7 @@ from ..limits.runs import switched_runs
 from ..limits.verdicts import limit_verdicts
 from ..machinery import checks
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
+from ..percussion.full_loop import limited_field
 from ..percussion.law import ANTI_WINDUP_TIME, closed_loop_rates, error_polynomial
 from ..trajectories import POSITIONS, heading_turns, make
 from .bound import cap_bound
@@ -95,7 +96,9 @@ def law_loop(body: Body, gains: Gains, ref, law: str, limits: Limits) -> LawLoop
 
     def both(t, s):
         return closed_loop_rates(body, coeffs, kin(t), s, limits, ANTI_WINDUP_TIME)
-    return LawLoop(lambda t, s: both(t, s)[0], lambda t, s: both(t, s)[1:], np.r_[s0, THRUST0])
+    # the fixed-step loops call the rates at one time on a few rows: the compiled field, the same to rounding
+    return LawLoop(limited_field(body, gains, ref, limits, ANTI_WINDUP_TIME), lambda t, s: both(t, s)[1:],
+                   np.r_[s0, THRUST0])
 
 
 def _measure(flow: FlowMap, loop: LawLoop, x, n_periods: int, ref, limits: Limits) -> dict:

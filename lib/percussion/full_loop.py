@@ -32,6 +32,7 @@ import numba
 import numpy as np
 import pandas as pd
 
+from ..allocation import Limits
 from ..angles import wrap_angle
 from ..dynamics import verdicts as dv
 from ..machinery import checks
@@ -41,7 +42,8 @@ from ..trajectories import eight_kinematics
 from .law import error_polynomial
 from .point import centre_of_percussion, lateral_drag_speed, point_accel, point_state
 
-__all__ = ["FULL_LOOP_OPTIONS", "THRUST0", "MAX_STEPS", "grid_sample", "compiled_rates", "steps_per_period",
+__all__ = ["FULL_LOOP_OPTIONS", "THRUST0", "MAX_STEPS", "grid_sample", "compiled_rates", "limited_field",
+           "steps_per_period",
            "start_error", "FullLoopMap",
            "full_loop_verdicts", "compare_with_zero_dynamics"]
 
@@ -61,18 +63,19 @@ _MINIMA = dict(chunk=3, max_periods=3, max_period=1, newton_iter=1, min_steps=8)
 
 
 @numba.njit(cache=True)
-def _field(t, y, out, R, Th, p, q):
-    """The rates of the 7 states (out, in place) and the force magnitude F (N), the eight (28) at
-    (R, Th); the law's model p = (m, I, a, c, c_phi, s_P, eps, k2x, k1x, k0x, k2y, k1y, k0y), the
-    plant q = (m, I, a, c, c_phi)."""
-    m, I, a, c, cphi, s, eps = p[0], p[1], p[2], p[3], p[4], p[5], p[6]
-    k = c / m
+def _field(t, y, out, R, Th, p, q, fc=math.inf, ac=math.pi, taw=0.0, circle=False):
+    """The 7 states' rates (out, in place) and the applied F (N) on the eight (28) at (R, Th) or the circle
+    (27); model p = (m, I, a, c, c_phi, s_P, eps, k2x, k1x, k0x, k2y, k1y, k0y), plant q = (m, I, a, c, c_phi);
+    cap ``fc`` (N), angle limit ``ac`` (rad), T_aw ``taw`` (s, 0: none) of law.closed_loop_rates."""
+    m, I, a, c, cphi, s, eps, k = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[3] / p[0]
     st = Th * t
     s1, c1, s2, c2 = math.sin(st), math.cos(st), math.sin(2 * st), math.cos(2 * st)
-    Pd = (0.5 * R * s2, R * s1)
-    dPd = (R * Th * c2, R * Th * c1)
-    ddPd = (-2 * R * Th * Th * s2, -R * Th * Th * s1)
-    dddPd = (-4 * R * Th ** 3 * c2, -R * Th ** 3 * c1)
+    if circle:
+        Pd, dPd = (R * c1, R * s1), (-R * Th * s1, R * Th * c1)
+        ddPd, dddPd = (-R * Th * Th * c1, -R * Th * Th * s1), (R * Th ** 3 * s1, -R * Th ** 3 * c1)
+    else:
+        Pd, dPd = (0.5 * R * s2, R * s1), (R * Th * c2, R * Th * c1)
+        ddPd, dddPd = (-2 * R * Th * Th * s2, -R * Th * Th * s1), (-4 * R * Th ** 3 * c2, -R * Th ** 3 * c1)
     phi, om, xi = y[2], y[5], y[6]
     cp, sp = math.cos(phi), math.sin(phi)
     P = (y[0] + s * cp, y[1] + s * sp)
@@ -85,12 +88,60 @@ def _field(t, y, out, R, Th, p, q):
     r2 = -g0 * sp + g1 * cp - along * om
     dom = r2 / eps
     u2 = (I * dom + cphi * om) / a
+    F, beta = math.hypot(xi, u2), math.atan2(u2, xi)
+    clipped = F > fc or abs(beta) > ac
+    if clipped:
+        F, beta = min(F, fc), min(max(beta, -ac), ac)
+        fx, fy, lat = F * math.cos(phi + beta), F * math.sin(phi + beta), F * math.sin(beta)
+    else:
+        fx, fy, lat = xi * cp - u2 * sp, xi * sp + u2 * cp, u2
     out[0], out[1], out[2] = y[3], y[4], om
-    out[3] = (xi * cp - u2 * sp - q[3] * y[3]) / q[0]
-    out[4] = (xi * sp + u2 * cp - q[3] * y[4]) / q[0]
-    out[5] = (q[2] * u2 - q[4] * om) / q[1]
+    out[3] = (fx - q[3] * y[3]) / q[0]
+    out[4] = (fy - q[3] * y[4]) / q[0]
+    out[5] = (q[2] * lat - q[4] * om) / q[1]
     out[6] = m * (r1 + 2 * s * om * dom)
-    return math.hypot(xi, u2)
+    if clipped and taw > 0:
+        out[6] += m * 2 * s * om * (out[5] - (a * u2 - cphi * om) / I) + (F * math.cos(beta) - xi) / taw
+    return F
+
+
+@numba.njit(cache=True)
+def _rows_field(t, Y, out, R, Th, p, q, fc, ac, taw, circle):
+    """:func:`_field` on every row of Y (M, 7), into out (M, 7)."""
+    for i in range(Y.shape[0]):
+        _field(t, Y[i], out[i], R, Th, p, q, fc, ac, taw, circle)
+
+
+def limited_field(body: Body, gains: Gains, ref, limits: Limits | None = None, anti_windup: float | None = None):
+    """The compiled field of the law for P under limits, for fixed-step loops on many rows: the rates
+    of :func:`lib.percussion.law.closed_loop_rates` (the body both plant and model), its limits and
+    anti-windup, to rounding (``tests/test_percussion_full_loop.py``).
+
+    Parameters
+    ----------
+    body, gains : Body, Gains
+        The body and the gains (:func:`lib.percussion.law.error_polynomial`).
+    ref : Reference
+        The eight or the circle (:func:`lib.trajectories.make`).
+    limits, anti_windup : Limits, float, optional
+        The limits on the applied force, and T_aw (s) > 0; None for none.
+
+    Returns
+    -------
+    callable
+        ``rates(t, Y)``: t (s) a float, Y (..., 7) the states; the rates, of Y's shape.
+    """
+    checks.one_of("the reference's kind", ref._kind, ("eight", "circle"))
+    limits = checks.instance("limits", Limits() if limits is None else limits, Limits)
+    fc, ac = (d if v is None else float(v) for v, d in ((limits.force, math.inf), (limits.angle, math.pi)))
+    taw = 0.0 if anti_windup is None else checks.number("anti_windup", anti_windup, positive=True, unit="s")
+    p, q, R, Th, circle = _params(body, gains), _plant(body), float(ref.R), float(ref.theta), ref._kind == "circle"
+
+    def rates(t, Y):
+        out = np.empty_like(Y := np.ascontiguousarray(Y, dtype=float))
+        _rows_field(float(t), Y.reshape(-1, 7), out.reshape(-1, 7), R, Th, p, q, fc, ac, taw, circle)
+        return out
+    return rates
 
 
 @numba.njit(cache=True)
@@ -124,8 +175,7 @@ def _periods(x, R, Th, steps, p, pl, k, fmax, emax):
             for i in range(d):
                 y[i] += h / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i])
             if not math.isfinite(y[2]) or abs(y[6]) > 1e12:
-                for i in range(d):
-                    y[i] = math.nan
+                y[:] = math.nan
                 fmax[q] = math.nan
                 break
 
