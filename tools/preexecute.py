@@ -9,7 +9,8 @@ that follows then finds every page's outputs there instead of executing it. Each
 myst-nb's own reader and the build's MyST configuration, so its cache key (the code cells and
 their metadata) is the one the build looks up; a page it misses is executed by the build itself.
 
-The kernels run with BLAS single-threaded (:data:`KERNEL_ENV`). Nothing from an earlier build is
+The kernels run with BLAS single-threaded, and numba on one thread when the pages fill the cores
+(:func:`kernel_env`). Nothing from an earlier build is
 reused: the cache is emptied first, and a page that fails stops
 the script with its traceback (the build is then not run). Pages that read other pages' results
 (``LAST``: the report, the errata and the front page's findings read the chapters' through :mod:`lib.machinery.cache`) start
