@@ -10,7 +10,8 @@ Target: <= 60 s, for these verdicts and for the book's map with its re-decisions
 Reference, per point, on a random sample: :func:`lib.simulate.simulate` (DOP853,
 rtol = atol = 1e-10) on the full 6-state closed loop (2)-(4), (23), (25)-(26), started
 on the reference, for the periods the fast verdict integrated plus 24, at least 48 and
-at most ``--periods`` (200), its verdict decided from its last ten periods: periodic
+at most ``--periods`` (200), in runs of whole periods that each fit simulate's step budget
+(:data:`lib.machinery.domain.MAX_RUN_STEPS`), its verdict decided from its last ten periods: periodic
 (or slipping) when the last periods repeat within 1e-6 rad at some lag k <= 8 (up to
 whole turns), otherwise irregular; the range over the last k periods from samples at
 the sweep's phases with the same Hermite refinement of the extremes.
@@ -39,7 +40,22 @@ def reference_verdict(body: Body, R: float, Theta: float, steps: int, periods: i
     T = 2 * math.pi / Theta
     last = max_lag + 2
     t_eval = T * (periods - last) + T * np.arange(1, last * steps + 1) / steps
-    res = simulate.simulate(body, Gains(), ref, float(t_eval[-1]), z0=ref.z(0.0), dz0=ref.dz(0.0), t_eval=t_eval)
+    # simulate refuses a run beyond its step budget (lib.machinery.domain.MAX_RUN_STEPS): whole
+    # periods at a time, halved until a run fits, each from the last one's end (the path and its
+    # heading are T-periodic); the last run holds t_eval
+    z, dz, done, k = ref.z(0.0), ref.dz(0.0), 0, periods - last
+    while done < periods - last:
+        n = min(k, periods - last - done)
+        try:
+            run = simulate.simulate(body, Gains(), ref, n * T, z0=z, dz0=dz, t_eval=[n * T])
+        except ValueError as err:
+            if "beyond the budget" not in str(err) or n == 1:
+                raise
+            k = n // 2
+            continue
+        z, dz, done = run.z[-1], run.dz[-1], done + n
+    tail = t_eval - done * T
+    res = simulate.simulate(body, Gains(), ref, float(tail[-1]), z0=z, dz0=dz, t_eval=tail)
     p = res.rotation_error().reshape(last, steps)
     dp = ((res.dz[:, 2] - res.dz_d[:, 2]) / Theta).reshape(last, steps)
     for k in range(1, max_lag + 1):
