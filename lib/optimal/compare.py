@@ -89,14 +89,13 @@ def law_loop(body: Body, gains: Gains, ref, law: str, limits: Limits) -> LawLoop
     position = POSITIONS[ref._kind]
 
     def kin(t):
-        t = np.asarray(t, dtype=float)
-        p = position(ref.R, ref.theta, t)
-        k = np.array(p) if t.ndim == 0 else np.stack(np.broadcast_arrays(*p), -1)   # one time: no broadcast
+        k = np.stack(np.broadcast_arrays(*position(ref.R, ref.theta, np.asarray(t, dtype=float))), -1)
         return tuple(k[..., 2 * j:2 * j + 2] for j in range(4))
 
     def both(t, s):
         return closed_loop_rates(body, coeffs, kin(t), s, limits, ANTI_WINDUP_TIME)
-    # the fixed-step loops call the rates at one time on a few rows: the compiled field, the same to rounding
+    # the fixed-step loops call the rates at one time on a few rows: the compiled field, the same to
+    # rounding; the inputs, read once over a recorded run, from lib.percussion.law
     return LawLoop(limited_field(body, gains, ref, limits, ANTI_WINDUP_TIME), lambda t, s: both(t, s)[1:],
                    np.r_[s0, THRUST0])
 
