@@ -88,10 +88,10 @@ def _field(t, y, out, R, Th, p, q, fc=math.inf, ac=math.pi, taw=0.0, circle=Fals
     r2 = -g0 * sp + g1 * cp - along * om
     dom = r2 / eps
     u2 = (I * dom + cphi * om) / a
-    F, beta = math.hypot(xi, u2), math.atan2(u2, xi)
-    clipped = F > fc or abs(beta) > ac
+    F = math.hypot(xi, u2)
+    clipped = F > fc or (ac < math.pi and abs(math.atan2(u2, xi)) > ac)   # no angle to take without a limit
     if clipped:
-        F, beta = min(F, fc), min(max(beta, -ac), ac)
+        F, beta = min(F, fc), min(max(math.atan2(u2, xi), -ac), ac)
         fx, fy, lat = F * math.cos(phi + beta), F * math.sin(phi + beta), F * math.sin(beta)
     else:
         fx, fy, lat = xi * cp - u2 * sp, xi * sp + u2 * cp, u2
@@ -107,7 +107,7 @@ def _field(t, y, out, R, Th, p, q, fc=math.inf, ac=math.pi, taw=0.0, circle=Fals
 
 @numba.njit(cache=True)
 def _rows_field(t, Y, out, R, Th, p, q, fc, ac, taw, circle):
-    """:func:`_field` on every row of Y (M, 7), into out (M, 7)."""
+    """``_field`` on every row of Y (M, 7), into out (M, 7)."""
     for i in range(Y.shape[0]):
         _field(t, Y[i], out[i], R, Th, p, q, fc, ac, taw, circle)
 
@@ -131,7 +131,7 @@ def limited_field(body: Body, gains: Gains, ref, limits: Limits | None = None, a
     callable
         ``rates(t, Y)``: t (s) a float, Y (..., 7) the states; the rates, of Y's shape.
     """
-    checks.one_of("the reference's kind", ref._kind, ("eight", "circle"))
+    checks.one_of("ref (its path's kind)", getattr(ref, "_kind", None), ("eight", "circle"))
     limits = checks.instance("limits", Limits() if limits is None else limits, Limits)
     fc, ac = (d if v is None else float(v) for v, d in ((limits.force, math.inf), (limits.angle, math.pi)))
     taw = 0.0 if anti_windup is None else checks.number("anti_windup", anti_windup, positive=True, unit="s")
