@@ -46,11 +46,11 @@ LAST = ("errata", "report", "intro")
 #: instead of 127). Each point of a parallel loop is computed alone, so the results do not
 #: depend on the threads (``make test-portable`` runs the tests on one).
 KERNEL_ENV = {"OPENBLAS_NUM_THREADS": "1"}
-#: a page's CPU time (s), measured (``make book-times``, 2026-11-26), to start the longest first
-#: (unknown pages first of all)
-COST = {"chapters/04_limits": 118, "chapters/05_stability": 90, "chapters/03_tracking": 61,
-        "chapters/06_allocation": 30, "chapters/07_percussion": 16, "chapters/02_controllability": 10,
-        "chapters/01_model": 3, "methods": 1, "chapters/08_optimal": 95}
+#: a page's CPU time (s), measured (the log of ``make book`` from an empty ``_build``, 2026-11-27),
+#: to start the longest first (unknown pages first of all)
+COST = {"chapters/04_limits": 116, "chapters/05_stability": 95, "chapters/03_tracking": 42,
+        "chapters/06_allocation": 29, "chapters/07_percussion": 16, "chapters/02_controllability": 10,
+        "chapters/01_model": 4, "methods": 2, "chapters/08_optimal": 80}
 
 
 def kernel_env(jobs: int, cores: int | None = None) -> dict:
