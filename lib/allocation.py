@@ -307,9 +307,8 @@ def allocate_limited(tau, phi, body: Body, weights=(1.0, 1.0, 0.0),
 
 
 def _limited(tau, phi, body: Body, sw, limits: Limits):
-    """The unvalidated kernel of :func:`allocate_limited`, for loops (``sw`` the square
-    roots of the weights): the problem by ``_ls_kernel``, its candidates by the compiled
-    ``_limited_rows``."""
+    """The unvalidated kernel of :func:`allocate_limited`, for loops (``sw`` the square roots of
+    the weights): the problem by ``_ls_kernel``, its candidates by the compiled ``_limited_rows``."""
     u_star, G, r, bb = _ls_kernel(tau, phi, body, sw)
     fmax, bmax = (d if x is None else float(x) for x, d in ((limits.force, np.inf), (limits.angle, np.pi)))
     shape = np.broadcast_shapes(u_star.shape[:-1], G.shape[:-2], r.shape[:-1], bb.shape)
@@ -328,16 +327,13 @@ def _limited_rows(u_star, G, r, bb, fmax, bmax, n_samples, n_newton):  # pragma:
     F, beta, cands = np.empty(n), np.empty(n), np.empty((6, 2))
     for q in range(n):
         g, r1, r2 = G[q], r[q, 0], r[q, 1]
-
-        def quad(u1, u2):
-            return u1 * (g[0, 0] * u1 + g[0, 1] * u2) + u2 * (g[1, 0] * u1 + g[1, 1] * u2)
         us1, us2 = u_star[q, 0], u_star[q, 1]
         fs = np.hypot(us1, us2)
         ok = fs <= fmax and (fs == 0 or abs(np.arctan2(us2, us1)) <= bmax)
         cands[0], cands[1], m = (us1, us2) if ok else (np.nan, np.nan), (0.0, 0.0), 2
         if bmax < np.pi:
             for d1, d2 in ((np.cos(bmax), np.sin(bmax)), (np.cos(bmax), -np.sin(bmax))):
-                dGd = quad(d1, d2)
+                dGd = _quad(g, d1, d2)
                 t = min(max((r1 * d1 + r2 * d2) / dGd if dGd > 0 else 0.0, 0.0), fmax)
                 cands[m], m = (t * d1, t * d2), m + 1
         if np.isfinite(fmax):
@@ -345,12 +341,18 @@ def _limited_rows(u_star, G, r, bb, fmax, bmax, n_samples, n_newton):  # pragma:
                 cands[m], m = (fmax * np.cos(b), fmax * np.sin(b)), m + 1
         win, least = 0, np.inf
         for i in range(m):
-            v = quad(cands[i, 0], cands[i, 1]) - 2 * (r1 * cands[i, 0] + r2 * cands[i, 1]) + bb[q]
+            v = _quad(g, cands[i, 0], cands[i, 1]) - 2 * (r1 * cands[i, 0] + r2 * cands[i, 1]) + bb[q]
             if v < least:                              # False for NaN
                 win, least = i, v
         F[q] = np.hypot(cands[win, 0], cands[win, 1])
         beta[q] = np.arctan2(cands[win, 1], cands[win, 0]) if F[q] > 0 else 0.0
     return F, beta
+
+
+@numba.njit(cache=True)
+def _quad(G, u1, u2):  # pragma: no cover (compiled)
+    """u' G u, u = (u1, u2), G (2, 2)."""
+    return u1 * (G[0, 0] * u1 + G[0, 1] * u2) + u2 * (G[1, 0] * u1 + G[1, 1] * u2)
 
 
 @numba.njit(cache=True)
@@ -368,7 +370,7 @@ def _arc_pair(G, r, fmax, bmax, n_samples, n_newton):  # pragma: no cover (compi
     h, Js, best = betas[1] - betas[0], np.empty(n_samples), np.full(2, -1)
     for k in range(n_samples):
         e1, e2 = fmax * np.cos(betas[k]), fmax * np.sin(betas[k])
-        Js[k] = e1 * (G[0, 0] * e1 + G[0, 1] * e2) + e2 * (G[1, 0] * e1 + G[1, 1] * e2) - 2 * (r[0] * e1 + r[1] * e2)
+        Js[k] = _quad(G, e1, e2) - 2 * (r[0] * e1 + r[1] * e2)
     for pick in range(2):                              # the least local minimum, then the next
         val = np.inf
         for k in range(n_samples):
