@@ -33,8 +33,8 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-import cvxpy as cp
 import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import minimize_scalar
@@ -42,6 +42,9 @@ from scipy.optimize import minimize_scalar
 from ..machinery import checks
 from ..params import Body
 from ..trajectories import KINEMATICS, POSITIONS
+
+if TYPE_CHECKING:  # imported where used: cvxpy loads in about 0.5 s, most pages never call it
+    import cvxpy as cp
 
 __all__ = ["IntervalMap", "interval_map", "exact_peak_force", "CapBound", "cap_bound", "MAX_NODES"]
 
@@ -232,6 +235,7 @@ class CapBound:
 def _solve(problem: cp.Problem, what: str) -> tuple[float, float]:
     """Solve with Clarabel through cvxpy's own chain, keeping Clarabel's solution object (cvxpy's
     ``solver_stats.extra_stats`` is empty for Clarabel). Returns (dual objective, absolute gap)."""
+    import cvxpy as cp
     for opts in SOLVER_OPTIONS:
         data, chain, inverse = problem.get_problem_data(solver="CLARABEL", solver_opts=dict(opts))
         raw = chain.solve_via_data(problem, data, solver_opts=dict(opts))
@@ -252,6 +256,7 @@ def _program(imap: IntervalMap, D: np.ndarray, F_max: float, objective: str, rel
     """The discrete problem on N nodes: variables C, p (N, 2), g = G/(F_max h) and, relaxed,
     e = E/delta (N, 2), all within unit balls; C and p periodic. ``coupled`` adds, per node,
     |G + al m E| <= F_max h at al = 1/wbar and al = -1/(w(0) - wbar) (see :func:`cap_bound`)."""
+    import cvxpy as cp
     N = D.shape[0]
     shift = sp.csr_matrix((np.ones(N), (np.arange(N), (np.arange(N) + 1) % N)), shape=(N, N))
     C, P, g = cp.Variable((N, 2)), cp.Variable((N, 2)), cp.Variable((N, 2))

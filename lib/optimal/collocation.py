@@ -28,11 +28,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
-import casadi as ca
 import numpy as np
 
 from ..params import Body
+
+if TYPE_CHECKING:  # imported where used: casadi loads in about 1 s, most pages never call it
+    import casadi as ca
 
 __all__ = ["Tableau", "tableau", "casadi_accel", "accel_function", "Transcription", "transcription",
            "ACCEPTED", "IPOPT_OPTIONS"]
@@ -86,6 +89,7 @@ def tableau(degree: int) -> Tableau:
     Tableau
         Its points, derivative matrix, end weights, quadrature weights and basis.
     """
+    import casadi as ca
     tau = np.concatenate([[0.0], np.asarray(ca.collocation_points(degree, "legendre"), dtype=float)])
     d = degree
     basis = np.empty((d + 1, d + 1))
@@ -127,6 +131,7 @@ def casadi_accel(body: Body, z, dz, F, beta):
     casadi.SX or casadi.MX
         (x'' (m/s^2), y'' (m/s^2), phi'' (rad/s^2)), a 3-vector.
     """
+    import casadi as ca
     psi = z[2] + beta
     return ca.vertcat((F * ca.cos(psi) - body.c * dz[0]) / body.m,
                       (F * ca.sin(psi) - body.c * dz[1]) / body.m,
@@ -146,6 +151,7 @@ def accel_function(body: Body) -> ca.Function:
     casadi.Function
         ``accel(z, dz, u)``; units as :func:`casadi_accel`.
     """
+    import casadi as ca
     z, dz, u = ca.SX.sym("z", 3), ca.SX.sym("dz", 3), ca.SX.sym("u", 2)
     return ca.Function("accel", [z, dz, u], [casadi_accel(body, z, dz, u[0], u[1])])
 
@@ -178,6 +184,7 @@ class Transcription:
 def _interval(body: Body, tab: Tableau) -> ca.Function:
     """One interval's residuals and cost: (X (6, d+1), u (2), X_next (6), h, Cd (2, d)) ->
     (g (6 (d + 1)), cost = sum_j B_j |C_j - Cd_j|^2)."""
+    import casadi as ca
     d = len(tab.B)
     X, u, Xn = ca.SX.sym("X", NX, d + 1), ca.SX.sym("u", 2), ca.SX.sym("Xn", NX)
     h, Cd = ca.SX.sym("h"), ca.SX.sym("Cd", 2, d)
@@ -212,6 +219,7 @@ def transcription(body: Body, nodes: int, degree: int) -> Transcription:
     Transcription
         The solver; call it with x0, lbx, ubx, lbg = ubg = 0 and p (see :class:`Transcription`).
     """
+    import casadi as ca
     tab = tableau(degree)
     d, N = degree, nodes
     block = NX * (d + 1) + 2

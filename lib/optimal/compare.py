@@ -201,9 +201,12 @@ def paper_rows(body: Body, gains: Gains, ref, settings=SETTINGS, *, horizon: int
 OPTIMAL_STEPS, OPTIMAL_PERIODS = 2, 8
 
 
-def _optimal_row(body: Body, motion, limits: Limits) -> dict:
+def _optimal_row(body: Body, motion, limits: Limits, solved: dict) -> dict:
+    """The optimal motion's row; its periodic LQR and verdict go into ``solved`` under ``limits``
+    (the basin of :func:`limits_study` reads them instead of solving them again)."""
     lqr = periodic_lqr(body, motion)
     v = motion_verdict(body, motion, limits=limits, lqr=lqr, steps=OPTIMAL_STEPS, periods=OPTIMAL_PERIODS)
+    solved[limits] = lqr, v
     T = motion.period
     x = v.x if np.isfinite(v.x).all() else np.concatenate(motion.state(0.0))
     res = track_motion(body, motion, T, limits=limits, z0=x[:3], dz0=x[3:], lqr=lqr,
@@ -242,6 +245,12 @@ def side_by_side(body: Body, gains: Gains, R: float, Theta: float, motions: dict
         Columns setting, angle_deg, cap, law, regime, reason, floquet, max_error, rms_error (m),
         F_peak (N), beta_peak (rad), p_range (rad).
     """
+    return _side_by_side(body, gains, R, Theta, motions, bounds, settings, kind, {})
+
+
+def _side_by_side(body, gains, R, Theta, motions, bounds, settings, kind, solved: dict) -> pd.DataFrame:
+    """:func:`side_by_side`, keeping each setting's (periodic LQR, verdict) of the optimal motion in
+    ``solved`` (Limits -> tuple)."""
     checks.instance("body", body, Body)
     checks.instance("gains", gains, Gains)
     ref = make(kind, R, Theta)
@@ -253,7 +262,7 @@ def side_by_side(body: Body, gains: Gains, R: float, Theta: float, motions: dict
         rows.append(dict(base, law="paper", **paper[i]))
         for law in LAWS[1:3]:
             rows.append(dict(base, law=law, **law_row(body, gains, ref, law, limits)))
-        rows.append(dict(base, law="optimal", **_optimal_row(body, motions[(angle, cap)], limits)))
+        rows.append(dict(base, law="optimal", **_optimal_row(body, motions[(angle, cap)], limits, solved)))
         if cap is not None:
             b = bounds[cap]
             rows.append(dict(base, law="bound", regime="", reason="", max_error=b.max_error,
@@ -277,20 +286,21 @@ def limits_study(body: Body, gains: Gains, R: float, Theta: float, *, kind: str 
     """
     motions = limit_motions(body, R, Theta, kind=kind)
     bound = cap_bound(body, R, Theta, PAPER_CAP, kind=kind)
-    table = side_by_side(body, gains, R, Theta, motions, {PAPER_CAP: bound}, kind=kind)
+    solved = {}
+    table = _side_by_side(body, gains, R, Theta, motions, {PAPER_CAP: bound}, SETTINGS, kind, solved)
     opt = table[table.law == "optimal"]
     missed = opt[~opt.paper_start_reached.astype(bool)]
     row = (missed if len(missed) else opt).iloc[0]
     key = (None if pd.isna(row.angle_deg) else int(row.angle_deg), None if pd.isna(row.cap) else float(row.cap))
     return dict(motions=motions, bound=bound, table=table, basin_setting=key,
-                basin=_basin(body, motions[key], key))
+                basin=_basin(body, motions[key], key, solved))
 
 
-def _basin(body: Body, motion, key) -> pd.DataFrame:
-    """:func:`lib.optimal.verdict.basin` of the best motion's controller at the setting ``key``."""
+def _basin(body: Body, motion, key, solved: dict) -> pd.DataFrame:
+    """:func:`lib.optimal.verdict.basin` of the best motion's controller at the setting ``key``,
+    from its periodic LQR and verdict in ``solved`` (:func:`_side_by_side`)."""
     limits = Limits(key[1], None if key[0] is None else math.radians(key[0]))
-    lqr = periodic_lqr(body, motion)
-    v = motion_verdict(body, motion, limits=limits, lqr=lqr, steps=OPTIMAL_STEPS, periods=OPTIMAL_PERIODS)
+    lqr, v = solved[limits]
     return basin(body, motion, v, limits=limits, lqr=lqr, periods=OPTIMAL_PERIODS, steps=OPTIMAL_STEPS)
 
 
