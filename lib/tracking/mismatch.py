@@ -27,11 +27,10 @@ import numpy as np
 import pandas as pd
 
 from ..machinery import checks
-from ..allocation import Limits, _position
+from ..allocation import Limits
+from ..angles import wrap_angle
 from ..dynamics import verdicts as dv
 from ..weighting.verdicts import _PeriodFlow, _decide, _loop_options, _observe, _start
-from ..control import demand
-from ..model import config_accel
 from ..machinery.parallel import concat_frames, map_chunks
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from ..trajectories import KINEMATICS
@@ -175,26 +174,31 @@ class _MismatchFlow(_PeriodFlow):
         self.scale = scale
 
     def rates(self, idx):
+        """dy/dtau of the rows ``idx``: (23) with each point's model, (25)-(26), (2)-(4), written
+        component by component on contiguous arrays: the operations of :func:`lib.control.demand`,
+        :func:`lib.allocation.allocate` (no limits) and :func:`lib.model.config_accel`, in their
+        order (``tests/test_mismatch.py`` checks the field against :class:`lib.closed_loop.ClosedLoop`
+        with each point's model); tau_phi is not formed: the paper's allocation does not read it."""
         b, g = self.body, self.gains
-        T = self.T[idx][:, None]
-        table = np.ascontiguousarray(self.table[:, :, idx].transpose(0, 2, 1))   # (2n, M, 9)
-        wind = self.wind[idx]
+        T = self.T[idx]
+        table = np.ascontiguousarray(self.table[:, :, idx])                     # (2n, 9, M)
         s = self.scale[idx]
-        mass = np.stack([b.m * s[:, 0], b.m * s[:, 0], b.I * s[:, 1]], axis=1)  # the model's M
-        drag = np.stack([b.c * s[:, 2], b.c * s[:, 2], b.c_phi * s[:, 3]], axis=1)  # and N
-        none = Limits()
+        m_x, c_x = b.m * s[:, 0], b.c * s[:, 2]                                 # the model's m and c
+        (kpx, kpy, _), (kvx, kvy, _) = g.kp, g.kv
+        m, c, c_phi, a, inertia = b.m, b.c, b.c_phi, b.a, b.I
 
         def f(tau, y):
-            turns, mi = self._phase(tau)
-            ref = table[mi]
-            z_d = ref[:, :3]
-            if turns:
-                z_d = z_d.copy()
-                z_d[:, 2] += turns * wind
-            z, dz = y[:, :3], y[:, 3:]
-            tau = demand(mass, drag, g, z_d, ref[:, 3:6], ref[:, 6:], z, dz)                      # (23)
-            F, beta = _position(tau, z[:, 2], none)                                            # (25)-(26)
-            return T * np.concatenate([dz, config_accel(b, z, dz, F, beta)], axis=1)               # (2)-(4)
+            _, mi = self._phase(tau)
+            xd, yd, _, vxd, vyd, _, axd, ayd, _ = table[mi]
+            x, yy, phi, vx, vy, vp = np.ascontiguousarray(y.T)
+            tx = m_x * axd + c_x * vx + kvx * (vxd - vx) + kpx * (xd - x)                        # (23)
+            ty = m_x * ayd + c_x * vy + kvy * (vyd - vy) + kpy * (yd - yy)
+            F = np.hypot(tx, ty)                                                               # (25)-(26)
+            beta = np.where(F > 0, wrap_angle(np.arctan2(ty, tx) - phi), 0.0)
+            psi = phi + beta
+            return np.stack([T * vx, T * vy, T * vp, T * ((F * np.cos(psi) - c * vx) / m),          # (2)-(4)
+                             T * ((F * np.sin(psi) - c * vy) / m), T * ((F * np.sin(beta) * a - c_phi * vp) / inertia)],
+                            axis=1)
         return f
 
 
