@@ -158,7 +158,11 @@ def eight_position(R, theta, t, cos=np.cos, sin=np.sin) -> tuple:
         (x_d, y_d, vx_d, vy_d, ax_d, ay_d, jx_d, jy_d) (m, m/s, m/s^2, m/s^3).
     """
     s = theta * t
-    c1, s1, c2, s2 = cos(s), sin(s), cos(2 * s), sin(2 * s)
+    return _eight_terms(R, theta, cos(s), sin(s), cos(2 * s), sin(2 * s))
+
+
+def _eight_terms(R, theta, c1, s1, c2, s2) -> tuple:
+    """:func:`eight_position`'s tuple from the cosines and sines of s = theta t and of 2 s."""
     return (0.5 * R * s2, R * s1, R * theta * c2, R * theta * c1, -2 * R * theta**2 * s2, -R * theta**2 * s1,
             -4 * R * theta**3 * c2, -R * theta**3 * c1)
 
@@ -218,9 +222,9 @@ def eight_kinematics(R, theta, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         As :func:`circle_kinematics`.
     """
     R, th, t = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (R, theta, t)))
-    x, y, vx, vy, ax, ay, _, _ = eight_position(R, th, t)
     s = th * t
     c1, s1, c2, s2 = np.cos(s), np.sin(s), np.cos(2 * s), np.sin(2 * s)
+    x, y, vx, vy, ax, ay, _, _ = _eight_terms(R, th, c1, s1, c2, s2)
     heading = np.pi + np.arctan2(-c1, -c2) - np.where(th < 0, np.pi, 0.0)
     num = 2 * c1 * s2 - c2 * s1
     den = c2**2 + c1**2
