@@ -30,6 +30,7 @@ from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from ..percussion.full_loop import limited_field
 from ..percussion.law import ANTI_WINDUP_TIME, closed_loop_rates, error_polynomial
 from ..trajectories import POSITIONS, heading_turns, make
+from ..weighting.field import limited_weighted_field
 from .bound import cap_bound
 from .loop import FlowMap, loop_verdict, run_periods, steady_measures
 from .study import PAPER_CAP, SETTINGS, limit_motions, setting_label
@@ -84,7 +85,11 @@ def law_loop(body: Body, gains: Gains, ref, law: str, limits: Limits) -> LawLoop
 
         def inputs(t, s):
             return loop.inputs(t, s[..., :3], s[..., 3:])[1:]
-        return LawLoop(lambda t, s: loop.rates(t, s)[0], inputs, s0)
+        # the weighted law's fixed-step loops call the rates at one time on a few rows: its compiled
+        # field, the same to rounding; the inputs, read once over a recorded run, from the loop
+        rates = limited_weighted_field(body, gains, ref, limits, WEIGHTS) if law == "weighted" else \
+            (lambda t, s: loop.rates(t, s)[0])
+        return LawLoop(rates, inputs, s0)
     coeffs = error_polynomial(body, gains)
     position = POSITIONS[ref._kind]
 
