@@ -1,5 +1,6 @@
-"""The compiled field of the weighted law under limits, for fixed-step loops on a few rows
-(Chapter 8's rows of the weighted law, :func:`lib.optimal.compare.law_loop`).
+"""The weighted law's fields compiled, for fixed-step loops on a few rows at a time: under limits
+(Chapter 8's rows of the weighted law, :func:`lib.optimal.compare.law_loop`), and the lean field
+without limits of Chapter 6's verdicts (:class:`lib.weighting.verdicts._PeriodFlow`, ``_lean_rows``).
 
 The rates of :class:`lib.closed_loop.ClosedLoop` with ``Allocation("limited", weights)``, the
 body both plant and model: the path's kinematics with its heading (the circle (27), the eight
@@ -26,6 +27,34 @@ from ..machinery import checks
 from ..params import Body, Gains
 
 __all__ = ["limited_weighted_field"]
+
+
+@numba.njit(cache=True)
+def _lean_rows(ref, turns, wind, Y, T, Tm, TI, w, k, b, out):  # pragma: no cover (compiled)
+    """The lean field of ``_PeriodFlow`` (its formulas, in their order) on every row of Y (M, 6):
+    ref (9, M) the path's (z_d, dz_d, ddz_d) at the stage's phase, the heading advanced by
+    ``turns`` whole periods of ``wind`` (M,) rad; T, Tm = T / m, TI = T / I (M,); w (4, M) the
+    weights w_x, w_y, w_phi a and w_phi a^2; k = (kp, kv) (6,); b = (m, I, c, c_phi, a)."""
+    m, I, c_lin, c_phi, a = b[0], b[1], b[2], b[3], b[4]
+    for q in range(Y.shape[0]):
+        x, yy, phi, vx, vy, vp = Y[q, 0], Y[q, 1], Y[q, 2], Y[q, 3], Y[q, 4], Y[q, 5]
+        wx, wy, wpa, wpa2 = w[0, q], w[1, q], w[2, q], w[3, q]
+        ep = ref[2, q] - phi
+        if turns:
+            ep = ep + turns * wind[q]
+        tx = m * ref[6, q] + c_lin * vx + k[3] * (ref[3, q] - vx) + k[0] * (ref[0, q] - x)          # (23)
+        ty = m * ref[7, q] + c_lin * vy + k[4] * (ref[4, q] - vy) + k[1] * (ref[1, q] - yy)
+        tp = I * ref[8, q] + c_phi * vp + k[5] * (ref[5, q] - vp) + k[2] * ep
+        c, s = math.cos(phi), math.sin(phi)
+        cc, ss, cs = c * c, s * s, c * s
+        G11, G12, G22 = wx * cc + wy * ss, (wy - wx) * cs, wx * ss + wy * cc + wpa2
+        r1, r2 = wx * c * tx + wy * s * ty, wy * c * ty - wx * s * tx + wpa * tp
+        det = G11 * G22 - G12 * G12
+        u1, u2 = (G22 * r1 - G12 * r2) / det, (G11 * r2 - G12 * r1) / det
+        out[q, 0], out[q, 1], out[q, 2] = T[q] * vx, T[q] * vy, T[q] * vp
+        out[q, 3] = Tm[q] * (c * u1 - s * u2 - c_lin * vx)
+        out[q, 4] = Tm[q] * (s * u1 + c * u2 - c_lin * vy)
+        out[q, 5] = TI[q] * (a * u2 - c_phi * vp)
 
 
 @numba.njit(cache=True)

@@ -26,6 +26,7 @@ from ..integrators import batch
 from ..machinery.parallel import concat_frames, map_chunks
 from ..params import Body, Gains
 from ..trajectories import KINEMATICS
+from .field import _lean_rows
 
 __all__ = ["LOOP_VERDICT_DEFAULTS", "closed_loop_verdicts"]
 
@@ -156,36 +157,21 @@ class _PeriodFlow:
 
     def _field(self, idx):
         """The lean field of the rows ``idx`` as a function (tau, y), with everything that does not
-        change along the run gathered once; component by component on contiguous arrays."""
+        change along the run gathered once; compiled (:func:`lib.weighting.field._lean_rows`)."""
         b, g = self.body, self.gains
-        T = self.T[idx]
-        table, wind = np.ascontiguousarray(self.table[:, :, idx]), self.wind[idx]   # (2n, 9, M)
+        T = np.ascontiguousarray(self.T[idx])
+        table, wind = np.ascontiguousarray(self.table[:, :, idx]), np.ascontiguousarray(self.wind[idx])  # (2n, 9, M)
         wx, wy, wp = (np.ascontiguousarray(c) for c in self.w[idx].T)
-        m, I, c_lin, c_phi, a = b.m, b.I, b.c, b.c_phi, b.a
-        (kpx, kpy, kpp), (kvx, kvy, kvp) = (float(v) for v in g.kp), (float(v) for v in g.kv)
-        wpa, wpa2 = wp * a, wp * a * a
-        Tm, TI = T / m, T / I
+        w = np.stack([wx, wy, wp * b.a, wp * b.a * b.a])
+        k = np.r_[g.kp, g.kv].astype(float)
+        bv = np.array([b.m, b.I, b.c, b.c_phi, b.a])
+        Tm, TI = T / b.m, T / b.I
 
         def f(tau, y):
             turns, mi = self._phase(tau)
-            xd, yd, pd_, vxd, vyd, vpd, axd, ayd, apd = table[mi]
-            x, yy, phi, vx, vy, vp = np.ascontiguousarray(y.T)
-            ep = pd_ - phi
-            if turns:
-                ep = ep + turns * wind
-            tx = m * axd + c_lin * vx + kvx * (vxd - vx) + kpx * (xd - x)          # (23)
-            ty = m * ayd + c_lin * vy + kvy * (vyd - vy) + kpy * (yd - yy)
-            tp = I * apd + c_phi * vp + kvp * (vpd - vp) + kpp * ep
-            c, s = np.cos(phi), np.sin(phi)
-            cc, ss, cs = c * c, s * s, c * s
-            G11, G12, G22 = wx * cc + wy * ss, (wy - wx) * cs, wx * ss + wy * cc + wpa2
-            r1, r2 = wx * c * tx + wy * s * ty, wy * c * ty - wx * s * tx + wpa * tp
-            det = G11 * G22 - G12 * G12
-            u1, u2 = (G22 * r1 - G12 * r2) / det, (G11 * r2 - G12 * r1) / det   # weighted LS, u = F (cos b, sin b)
-            return np.stack([T * vx, T * vy, T * vp,
-                             Tm * (c * u1 - s * u2 - c_lin * vx),                   # Q = B(phi) u (22), (2)-(4)
-                             Tm * (s * u1 + c * u2 - c_lin * vy),
-                             TI * (a * u2 - c_phi * vp)], axis=1)
+            out = np.empty((T.size, 6))
+            _lean_rows(table[mi], turns, wind, np.ascontiguousarray(y, dtype=float), T, Tm, TI, w, k, bv, out)
+            return out
         return f
 
     def rates(self, idx):
