@@ -1,6 +1,6 @@
 """The weighted law's fields compiled, for fixed-step loops on a few rows at a time: under limits
 (Chapter 8's rows of the weighted law, :func:`lib.optimal.compare.law_loop`), and the lean field
-without limits of Chapter 6's verdicts (:class:`lib.weighting.verdicts._PeriodFlow`, ``_lean_rows``).
+without limits of Chapter 6's verdicts (``lib.weighting.verdicts._PeriodFlow``, ``_lean_rows``).
 
 The rates of :class:`lib.closed_loop.ClosedLoop` with ``Allocation("limited", weights)``, the
 body both plant and model: the path's kinematics with its heading (the circle (27), the eight
@@ -8,7 +8,7 @@ body both plant and model: the path's kinematics with its heading (the circle (2
 write them), the demand (23), the weighted least-squares problem of
 :func:`lib.allocation.least_squares_problem` (its closed form; a row whose normal equations are
 singular is solved by the pseudo-inverse, in numpy), the allocation under the limits by the
-compiled :func:`lib.allocation._limited_rows`, and (2)-(4). The same formulas, in their order,
+compiled ``lib.allocation._limited_rows``, and (2)-(4). The same formulas, in their order,
 compiled: equal to rounding (``tests/test_weighting_field.py``), about 30 times faster a call on
 a few rows than the numpy loop, whose cost is its calls' overhead.
 

@@ -157,7 +157,7 @@ class _PeriodFlow:
 
     def _field(self, idx):
         """The lean field of the rows ``idx`` as a function (tau, y), with everything that does not
-        change along the run gathered once; compiled (:func:`lib.weighting.field._lean_rows`)."""
+        change along the run gathered once; compiled (``lib.weighting.field._lean_rows``)."""
         b, g = self.body, self.gains
         T = np.ascontiguousarray(self.T[idx])
         table, wind = np.ascontiguousarray(self.table[:, :, idx]), np.ascontiguousarray(self.wind[idx])  # (2n, 9, M)
