@@ -9,8 +9,8 @@ write them), the demand (23), the weighted least-squares problem of
 :func:`lib.allocation.least_squares_problem` (its closed form; a row whose normal equations are
 singular is solved by the pseudo-inverse, in numpy), the allocation under the limits by the
 compiled ``lib.allocation._limited_rows``, and (2)-(4). The same formulas, in their order,
-compiled: equal to rounding (``tests/test_weighting_field.py``), about 30 times faster a call on
-a few rows than the numpy loop, whose cost is its calls' overhead.
+compiled: equal to rounding (``tests/test_weighting_field.py``), about seven times faster a call
+on a few rows than the numpy loop, whose cost is its calls' overhead.
 
 Units: SI (m, rad, s, N).
 """
