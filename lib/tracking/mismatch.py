@@ -20,15 +20,16 @@ Units: R in m, Theta in rad/s, errors in m, relative errors dimensionless.
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from typing import Mapping
 
+import numba
 import numpy as np
 import pandas as pd
 
 from ..machinery import checks
 from ..allocation import Limits
-from ..angles import wrap_angle
 from ..dynamics import verdicts as dv
 from ..weighting.verdicts import _PeriodFlow, _decide, _loop_options, _observe, _start
 from ..machinery.parallel import concat_frames, map_chunks
@@ -162,6 +163,35 @@ def error_equation():
     return lhs, rhs, names
 
 
+@numba.njit(cache=True)
+def _mismatch_rows(ref, Y, T, model, k, plant, out):  # pragma: no cover (compiled)
+    """dy/dtau of the rows of Y (M, 6): (23) with each row's model m, c (``model`` (2, M)) and the
+    gains k = (kp_x, kp_y, kv_x, kv_y), the paper's allocation (25)-(26) without limits, and (2)-(4)
+    of the plant (m, I, c, c_phi, a); ``ref`` (9, M) the path at the stage's phase, T (M,) the
+    periods. The operations of :func:`lib.control.demand`, :func:`lib.allocation.allocate` and
+    :func:`lib.model.config_accel`, in their order (``tests/test_mismatch.py`` checks the field
+    against :class:`lib.closed_loop.ClosedLoop` with each point's model)."""
+    m, I, c, c_phi, a = plant[0], plant[1], plant[2], plant[3], plant[4]
+    for q in range(Y.shape[0]):
+        x, yy, phi, vx, vy, vp = Y[q, 0], Y[q, 1], Y[q, 2], Y[q, 3], Y[q, 4], Y[q, 5]
+        mx, cx = model[0, q], model[1, q]
+        tx = mx * ref[6, q] + cx * vx + k[2] * (ref[3, q] - vx) + k[0] * (ref[0, q] - x)     # (23)
+        ty = mx * ref[7, q] + cx * vy + k[3] * (ref[4, q] - vy) + k[1] * (ref[1, q] - yy)
+        F = math.hypot(tx, ty)                                                         # (25)-(26)
+        beta = 0.0
+        if F > 0:
+            d = math.atan2(ty, tx) - phi
+            beta = math.pi - (math.pi - d) % (2 * math.pi)         # lib.angles.wrap_angle's formula
+            if beta == -math.pi:
+                beta = math.pi
+        psi = phi + beta
+        Tq = T[q]
+        out[q, 0], out[q, 1], out[q, 2] = Tq * vx, Tq * vy, Tq * vp
+        out[q, 3] = Tq * ((F * math.cos(psi) - c * vx) / m)                             # (2)-(4)
+        out[q, 4] = Tq * ((F * math.sin(psi) - c * vy) / m)
+        out[q, 5] = Tq * ((F * math.sin(beta) * a - c_phi * vp) / I)
+
+
 class _MismatchFlow(_PeriodFlow):
     """The full closed loop's period map (:class:`lib.weighting.verdicts._PeriodFlow`, whose
     tables, sections and error map it keeps) with (23) computed from a model of its own
@@ -174,31 +204,20 @@ class _MismatchFlow(_PeriodFlow):
         self.scale = scale
 
     def rates(self, idx):
-        """dy/dtau of the rows ``idx``: (23) with each point's model, (25)-(26), (2)-(4), written
-        component by component on contiguous arrays: the operations of :func:`lib.control.demand`,
-        :func:`lib.allocation.allocate` (no limits) and :func:`lib.model.config_accel`, in their
-        order (``tests/test_mismatch.py`` checks the field against :class:`lib.closed_loop.ClosedLoop`
-        with each point's model); tau_phi is not formed: the paper's allocation does not read it."""
+        """dy/dtau of the rows ``idx``: (23) with each point's model, (25)-(26), (2)-(4), compiled
+        (:func:`_mismatch_rows`). tau_phi is not formed: the paper's allocation does not read it."""
         b, g = self.body, self.gains
-        T = self.T[idx]
+        T = np.ascontiguousarray(self.T[idx])
         table = np.ascontiguousarray(self.table[:, :, idx])                     # (2n, 9, M)
         s = self.scale[idx]
-        m_x, c_x = b.m * s[:, 0], b.c * s[:, 2]                                 # the model's m and c
-        (kpx, kpy, _), (kvx, kvy, _) = g.kp, g.kv
-        m, c, c_phi, a, inertia = b.m, b.c, b.c_phi, b.a, b.I
+        model = np.stack([b.m * s[:, 0], b.c * s[:, 2]])                        # the model's m and c (2, M)
+        k = np.array([g.kp[0], g.kp[1], g.kv[0], g.kv[1]], dtype=float)
+        plant = np.array([b.m, b.I, b.c, b.c_phi, b.a])
 
         def f(tau, y):
-            _, mi = self._phase(tau)
-            xd, yd, _, vxd, vyd, _, axd, ayd, _ = table[mi]
-            x, yy, phi, vx, vy, vp = np.ascontiguousarray(y.T)
-            tx = m_x * axd + c_x * vx + kvx * (vxd - vx) + kpx * (xd - x)                        # (23)
-            ty = m_x * ayd + c_x * vy + kvy * (vyd - vy) + kpy * (yd - yy)
-            F = np.hypot(tx, ty)                                                               # (25)-(26)
-            beta = np.where(F > 0, wrap_angle(np.arctan2(ty, tx) - phi), 0.0)
-            psi = phi + beta
-            return np.stack([T * vx, T * vy, T * vp, T * ((F * np.cos(psi) - c * vx) / m),          # (2)-(4)
-                             T * ((F * np.sin(psi) - c * vy) / m), T * ((F * np.sin(beta) * a - c_phi * vp) / inertia)],
-                            axis=1)
+            out = np.empty((T.size, 6))
+            _mismatch_rows(table[self._phase(tau)[1]], np.ascontiguousarray(y, dtype=float), T, model, k, plant, out)
+            return out
         return f
 
 
