@@ -5,14 +5,17 @@ This is the single closed-loop right-hand side behind the smooth integrator
 (:func:`lib.simulate.simulate`) and the batch integrator
 (:func:`lib.weighting.batch.closed_loop_batch`); the switched integrator
 (:mod:`lib.integrators.switched`) uses a scalar fast path of the same equations,
-tested against this one at random states.
+tested against this one at random states. :func:`paper_rates` is the paper's law on the
+circle or the eight compiled, for the smooth integrator's one state at a time.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Callable
 
+import numba
 import numpy as np
 
 from .machinery import checks
@@ -21,7 +24,7 @@ from .control import computed_torque_from
 from .model import config_accel
 from .params import Body, Gains
 
-__all__ = ["ClosedLoop", "reference_of"]
+__all__ = ["ClosedLoop", "reference_of", "paper_rates"]
 
 #: t -> (z_d, dz_d, ddz_d), each of shape (..., 3)
 Kinematics = Callable[[object], tuple]
@@ -114,3 +117,87 @@ class ClosedLoop:
         z, dz = s[..., :3], s[..., 3:]
         _, F, beta = self.inputs(t, z, dz)
         return np.concatenate([dz, config_accel(self.body, z, dz, F, beta)], axis=-1), F
+
+
+@numba.njit(cache=True)
+def _paper_rows(t, Y, eight, R, Th, model, k, plant, fmax, bmax, out):  # pragma: no cover (compiled)
+    """s' of the rows of Y (M, 6) under the paper's law: the path's position and derivatives
+    (:func:`lib.trajectories.eight_position`, :func:`lib.trajectories.circle_position`), (23)
+    with the model's m and c (``model``) and k = (kp_x, kp_y, kv_x, kv_y), (25)-(26) under the
+    cap ``fmax`` and the angle limit ``bmax``, (2)-(4) of the plant (m, I, c, c_phi, a): the
+    operations of :meth:`ClosedLoop.rates`, in their order."""
+    s = Th * t
+    if eight:
+        c1, s1, c2, s2 = math.cos(s), math.sin(s), math.cos(2 * s), math.sin(2 * s)
+        xd, yd, vxd, vyd, axd, ayd = (0.5 * R * s2, R * s1, R * Th * c2, R * Th * c1, -2 * R * Th**2 * s2,
+                                      -R * Th**2 * s1)
+    else:
+        c, sn = math.cos(s), math.sin(s)
+        xd, yd, vxd, vyd, axd, ayd = R * c, R * sn, -R * Th * sn, R * Th * c, -R * Th**2 * c, -R * Th**2 * sn
+    mm, cm = model[0], model[1]
+    m, I, c_lin, c_phi, a = plant[0], plant[1], plant[2], plant[3], plant[4]
+    for q in range(Y.shape[0]):
+        x, y, phi, vx, vy, vp = Y[q, 0], Y[q, 1], Y[q, 2], Y[q, 3], Y[q, 4], Y[q, 5]
+        tx = mm * axd + cm * vx + k[2] * (vxd - vx) + k[0] * (xd - x)                       # (23)
+        ty = mm * ayd + cm * vy + k[3] * (vyd - vy) + k[1] * (yd - y)
+        F = math.hypot(tx, ty)                                                        # (25)-(26)
+        beta = 0.0
+        if F > 0:
+            d = math.atan2(ty, tx) - phi
+            beta = math.pi - (math.pi - d) % (2 * math.pi)            # lib.angles.wrap_angle's formula
+            if beta == -math.pi:
+                beta = math.pi
+        F = min(F, fmax)                                                              # Limits.apply
+        beta = min(max(beta, -bmax), bmax)
+        psi = phi + beta
+        out[q, 0], out[q, 1], out[q, 2] = vx, vy, vp
+        out[q, 3] = (F * math.cos(psi) - c_lin * vx) / m                                # (2)-(4)
+        out[q, 4] = (F * math.sin(psi) - c_lin * vy) / m
+        out[q, 5] = (F * math.sin(beta) * a - c_phi * vp) / I
+
+
+def paper_rates(body: Body, gains: Gains, ref, allocation: Allocation | None = None, limits: Limits | None = None,
+                model: Body | None = None):
+    """The rates of :meth:`ClosedLoop.rates` compiled, where the loop is the paper's law
+    ((25)-(26), ``Allocation()``, under any ``limits``, with any ``model``) on the circle or the
+    eight of :mod:`lib.trajectories`: the same formulas, to rounding (``tests/test_simulate.py``);
+    None for another law or path.
+
+    Parameters
+    ----------
+    body, gains : Body, Gains
+        The plant and the gains of (23).
+    ref : Reference
+        The path.
+    allocation : Allocation, optional
+        The allocation law (default the paper's).
+    limits : Limits, optional
+        Force and angle limits (default none).
+    model : Body, optional
+        The controller's model (default the plant).
+
+    Returns
+    -------
+    callable or None
+        ``rates(t, s)``: t (s) a float, s (..., 6) the states; s', of s's shape.
+    """
+    checks.instance("body", body, Body)
+    checks.instance("gains", gains, Gains)
+    allocation = checks.instance("allocation", Allocation() if allocation is None else allocation, Allocation)
+    limits = checks.instance("limits", Limits() if limits is None else limits, Limits)
+    kind = getattr(ref, "_kind", None)
+    if allocation.law != "position" or kind not in ("eight", "circle"):
+        return None
+    md = body if model is None else checks.instance("model", model, Body, "lib.params.Body or None")
+    args = (kind == "eight", float(ref.R), float(ref.theta), np.array([md.m, md.c]),
+            np.array([gains.kp[0], gains.kp[1], gains.kv[0], gains.kv[1]], dtype=float),
+            np.array([body.m, body.I, body.c, body.c_phi, body.a]),
+            math.inf if limits.force is None else float(limits.force),
+            math.inf if limits.angle is None else float(limits.angle))
+
+    def rates(t, s):
+        s = np.ascontiguousarray(s, dtype=float)
+        out = np.empty_like(s)
+        _paper_rows(float(t), s.reshape(-1, 6), *args, out.reshape(-1, 6))
+        return out
+    return rates
