@@ -29,6 +29,7 @@ from ..model import config_accel, generalized_force
 from ..params import PAPER_DZ0, PAPER_Z0, Body
 from ..simulate import DEFAULT_RATE, SimulationResult
 from ..trajectories import make
+from .riccati import riccati_rhs
 
 __all__ = ["PeriodicLQR", "jacobians", "periodic_lqr", "track_motion",
            "DEFAULT_Q", "DEFAULT_R", "RTOL", "NEWTON_TOL", "NEWTON_ITER", "NEWTON_STALL", "REACH_TOL",
@@ -283,8 +284,12 @@ def periodic_lqr(body: Body, motion, *, Q=None, R_weight=None, samples: int = 10
     samples = checks.integer("samples", samples, minimum=16)
     Rinv, T = np.linalg.inv(R), float(motion.period)
 
+    fast = riccati_rhs(body, motion, Q, Rinv)      # compiled, for the motions of periodic_motion
+
     def piece(lo, hi):
         def rhs(t, p):
+            if fast is not None:
+                return fast(t, p, _inside(t, lo, hi))
             A, B = _jacobians(body, *_reference(motion, t, _inside(t, lo, hi)))
             return _riccati_rate(A, B, p.reshape(6, 6), Rinv, Q).ravel()
         return rhs
