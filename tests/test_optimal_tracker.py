@@ -320,11 +320,12 @@ def test_default_starts_are_the_paper_start_and_its_shifts():
 
 
 def test_the_compiled_riccati_rhs_is_the_numpy_one_on_a_collocated_motion(body):
-    """lib.optimal.riccati against the numpy right-hand side it compiles, on a motion with
-    collocation polynomials and piecewise-constant inputs (random: the rhs does not need a solution),
-    at times inside, on and beyond the nodes, with heading turns."""
+    """lib.optimal.riccati against the numpy right-hand sides it compiles (the Riccati equation's,
+    the linearised closed loop's), on a motion with collocation polynomials and piecewise-constant
+    inputs and an LQR with a random grid of P (random: the rhs needs no solution), at times
+    inside, on and beyond the nodes, with heading turns."""
     from lib.optimal.motion import PeriodicMotion
-    from lib.optimal.riccati import riccati_rhs
+    from lib.optimal.riccati import closed_loop_rhs, riccati_rhs
     rng = np.random.default_rng(8)
     nodes, degree, T = 8, 3, 5.0
     motion = PeriodicMotion(t=np.arange(nodes) * T / nodes, z=np.zeros((nodes, 3)), dz=np.zeros((nodes, 3)),
@@ -345,3 +346,17 @@ def test_the_compiled_riccati_rhs_is_the_numpy_one_on_a_collocated_motion(body):
         # measured equal bit for bit over 420 times here; the bound allows rounding of terms up to 3e3
         np.testing.assert_allclose(fast(t, P.ravel(), t_in), want, rtol=1e-12, atol=1e-11)
     assert riccati_rhs(body, _CircleMotion(body), Q, R_inv) is None   # no polynomials: the numpy rhs
+    grid = np.union1d(np.linspace(0, T, 33), motion.t)
+    P = rng.normal(size=(grid.size, 6, 6))
+    lqr = tracker.PeriodicLQR(body, motion, Q, tracker.DEFAULT_R, grid, P + np.swapaxes(P, 1, 2),
+                              rng.normal(size=(grid.size - 1, 2, 6, 6)), 1, 0.0, np.zeros(6))
+    loop = closed_loop_rhs(lqr)
+    for t in np.r_[rng.uniform(-7, 13, 40), grid[:-1], grid[1:] + 2 * T]:
+        Y = rng.normal(size=(6, 6))
+        t_in = T / nodes * (np.floor(t * nodes / T) + 0.5)
+        x, u = tracker._reference(motion, t, t_in)
+        A, B = tracker._jacobians(body, x, u)
+        want = ((A - B @ lqr._gain(t, x, u)) @ Y).ravel()
+        # accuracy: as above (with LAPACK's 2 x 2 solve for the gain): measured equal bit for bit here
+        np.testing.assert_allclose(loop(t, Y.ravel(), t_in), want, rtol=1e-12, atol=1e-11)
+    assert closed_loop_rhs(tracker.periodic_lqr(body, _CircleMotion(body))) is None

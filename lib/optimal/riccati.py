@@ -1,12 +1,15 @@
-"""The right-hand side of the periodic Riccati equation of :func:`lib.optimal.tracker.periodic_lqr`,
-compiled, for a motion of :func:`lib.optimal.motion.periodic_motion` (its collocation polynomials
-and piecewise-constant inputs).
+"""The right-hand sides of :func:`lib.optimal.tracker.periodic_lqr` compiled, for a motion of
+:func:`lib.optimal.motion.periodic_motion` (its collocation polynomials and piecewise-constant
+inputs): the periodic Riccati equation's (:func:`riccati_rhs`) and the linearised closed loop's,
+whose monodromy matrix gives the multipliers (:func:`closed_loop_rhs`).
 
-``solve_ivp`` calls it on one matrix P at a time, about 12 000 times a Riccati solution, so the
-numpy version's cost was its calls' overhead: the motion's state read from its polynomials
+``solve_ivp`` calls them on one matrix at a time, about 12 000 times a Riccati solution, so the
+numpy versions' cost was their calls' overhead: the motion's state read from its polynomials
 (:meth:`lib.optimal.motion.PeriodicMotion.state`, :meth:`~lib.optimal.motion.PeriodicMotion.inputs`),
-the Jacobians of (2)-(4) (:func:`lib.optimal.tracker.jacobians`) and -P' = A'P + PA - P B R^-1 B' P + Q.
-Here the same formulas, in their order (the products by numba's BLAS calls): equal to the numpy right-hand side to rounding (``tests/test_optimal_tracker.py``).
+the Jacobians of (2)-(4) (:func:`lib.optimal.tracker.jacobians`), -P' = A'P + PA - P B R^-1 B' P + Q,
+the gain K = R^-1 B' P(t) from P's cubic Hermite interpolant. Here the same formulas in their
+order, the products and the 2 x 2 solve by numba's BLAS and LAPACK calls: equal to the numpy
+right-hand sides to rounding (``tests/test_optimal_tracker.py``; bit for bit on this machine).
 
 Units: SI (s, m, rad, N).
 """
@@ -21,7 +24,7 @@ import numpy as np
 from ..params import Body
 from .collocation import tableau
 
-__all__ = ["riccati_rhs"]
+__all__ = ["riccati_rhs", "closed_loop_rhs"]
 
 #: a node time computed in floating point belongs to the interval it starts (as :mod:`lib.optimal.motion`)
 _SNAP = 1e-9
@@ -37,8 +40,9 @@ def _locate(t, period, nodes):  # pragma: no cover (compiled)
 
 
 @numba.njit(cache=True)
-def _rhs(t, t_in, p, period, nodes, turns, F, beta, basis, colloc, body, Rinv, Q, out):  # pragma: no cover
-    """-P' at t for P = p (36,) into out (36,): the motion's state at t, its inputs at t_in."""
+def _jac(t, t_in, period, nodes, turns, F, beta, basis, colloc, body):  # pragma: no cover (compiled)
+    """A (6, 6) and B (6, 2) of (2)-(4) about the motion's state at t and its inputs at t_in, as
+    ``lib.optimal.tracker._reference`` and ``_jacobians`` compute them."""
     k, s, laps = _locate(t, period, nodes)
     d1 = basis.shape[0]
     x = np.zeros(6)
@@ -64,11 +68,38 @@ def _rhs(t, t_in, p, period, nodes, turns, F, beta, basis, colloc, body, Rinv, Q
     B[3, 0], B[3, 1] = co / m, -f * si / m
     B[4, 0], B[4, 1] = si / m, f * co / m
     B[5, 0], B[5, 1] = ia * math.sin(b), ia * f * math.cos(b)
+    return A, B
+
+
+@numba.njit(cache=True)
+def _rhs(t, t_in, p, period, nodes, turns, F, beta, basis, colloc, body, Rinv, Q, out):  # pragma: no cover
+    """-P' at t for P = p (36,) into out (36,): the motion's state at t, its inputs at t_in."""
+    A, B = _jac(t, t_in, period, nodes, turns, F, beta, basis, colloc, body)
     P = p.reshape(6, 6)
     M = A.T @ P + P @ A - P @ B @ Rinv @ np.ascontiguousarray(B.T) @ P + Q
     for i in range(6):
         for j in range(6):
             out[6 * i + j] = -M[i, j]
+
+
+@numba.njit(cache=True)
+def _closed_rhs(t, t_in, y, period, nodes, turns, F, beta, basis, colloc, body, R, grid, PG, dPG,
+                out):  # pragma: no cover (compiled)
+    """(A - B K) Y at t for Y = y (36,) into out (36,), K = R^-1 B' P(t) with P(t) the cubic Hermite
+    interpolant of the grid's P, dP (``PeriodicLQR.riccati``, ``PeriodicLQR._gain``)."""
+    A, B = _jac(t, t_in, period, nodes, turns, F, beta, basis, colloc, body)
+    s = np.mod(t, period)
+    n = grid.size
+    k = min(max(np.searchsorted(grid, s, side="right") - 1, 0), n - 2)
+    h = grid[k + 1] - grid[k]
+    r = (s - grid[k]) / h
+    P = ((1 + 2 * r) * (1 - r) ** 2 * PG[k] + r * (1 - r) ** 2 * h * dPG[k, 0]
+         + r * r * (3 - 2 * r) * PG[k + 1] - r * r * (1 - r) * h * dPG[k, 1])
+    K = np.linalg.solve(R, np.ascontiguousarray(B.T) @ P)
+    M = (A - B @ K) @ y.reshape(6, 6)
+    for i in range(6):
+        for j in range(6):
+            out[6 * i + j] = M[i, j]
 
 
 def riccati_rhs(body: Body, motion, Q: np.ndarray, R_inv: np.ndarray):
@@ -92,17 +123,49 @@ def riccati_rhs(body: Body, motion, Q: np.ndarray, R_inv: np.ndarray):
     """
     if not all(hasattr(motion, a) for a in ("collocation", "nodes", "degree", "F", "beta")):
         return None
-    basis = np.ascontiguousarray(tableau(int(motion.degree)).basis, dtype=float)
-    colloc = np.ascontiguousarray(motion.collocation, dtype=float)
-    F, beta = np.ascontiguousarray(motion.F, dtype=float), np.ascontiguousarray(motion.beta, dtype=float)
-    bv = np.array([body.m, body.I, body.a, body.c, body.c_phi], dtype=float)
-    Rinv = np.ascontiguousarray(R_inv, dtype=float)
-    Qc = np.ascontiguousarray(Q, dtype=float)
-    period, nodes, turns = float(motion.period), int(motion.nodes), int(motion.turns)
+    args = _motion_arrays(body, motion)
+    Rinv, Qc = np.ascontiguousarray(R_inv, dtype=float), np.ascontiguousarray(Q, dtype=float)
 
     def rhs(t, p, t_in):
         out = np.empty(36)
-        _rhs(float(t), float(t_in), np.ascontiguousarray(p, dtype=float), period, nodes, turns, F, beta, basis,
-             colloc, bv, Rinv, Qc, out)
+        _rhs(float(t), float(t_in), np.ascontiguousarray(p, dtype=float), *args, Rinv, Qc, out)
         return out
     return rhs
+
+
+def closed_loop_rhs(lqr):
+    """The compiled right-hand side of the linearised closed loop Y' = (A - B K(t)) Y of a periodic
+    LQR (:func:`lib.optimal.tracker.periodic_lqr`, for its monodromy matrix), or None for a motion
+    without collocation polynomials.
+
+    Parameters
+    ----------
+    lqr : PeriodicLQR
+        The periodic LQR.
+
+    Returns
+    -------
+    callable or None
+        ``rhs(t, y, t_in)``: Y' (36,) for Y = y (36,), the inputs read at ``t_in`` (s).
+    """
+    motion, body = lqr.motion, lqr.body
+    if not all(hasattr(motion, a) for a in ("collocation", "nodes", "degree", "F", "beta")):
+        return None
+    args = _motion_arrays(body, motion)
+    R, grid = np.ascontiguousarray(lqr.R, dtype=float), np.ascontiguousarray(lqr.t, dtype=float)
+    PG, dPG = np.ascontiguousarray(lqr.P, dtype=float), np.ascontiguousarray(lqr.dP, dtype=float)
+
+    def rhs(t, y, t_in):
+        out = np.empty(36)
+        _closed_rhs(float(t), float(t_in), np.ascontiguousarray(y, dtype=float), *args, R, grid, PG, dPG, out)
+        return out
+    return rhs
+
+
+def _motion_arrays(body: Body, motion) -> tuple:
+    """(period, nodes, turns, F, beta, basis, collocation, body) for the kernels."""
+    return (float(motion.period), int(motion.nodes), int(motion.turns),
+            np.ascontiguousarray(motion.F, dtype=float), np.ascontiguousarray(motion.beta, dtype=float),
+            np.ascontiguousarray(tableau(int(motion.degree)).basis, dtype=float),
+            np.ascontiguousarray(motion.collocation, dtype=float),
+            np.array([body.m, body.I, body.a, body.c, body.c_phi], dtype=float))

@@ -29,7 +29,7 @@ from ..model import config_accel, generalized_force
 from ..params import PAPER_DZ0, PAPER_Z0, Body
 from ..simulate import DEFAULT_RATE, SimulationResult
 from ..trajectories import make
-from .riccati import riccati_rhs
+from .riccati import closed_loop_rhs, riccati_rhs
 
 __all__ = ["PeriodicLQR", "jacobians", "periodic_lqr", "track_motion",
            "DEFAULT_Q", "DEFAULT_R", "RTOL", "NEWTON_TOL", "NEWTON_ITER", "NEWTON_STALL", "REACH_TOL",
@@ -317,8 +317,12 @@ def periodic_lqr(body: Body, motion, *, Q=None, R_weight=None, samples: int = 10
 
 def _monodromy_multipliers(lqr: PeriodicLQR) -> np.ndarray:
     """Floquet multipliers of x' = (A - B K)(t) x over one period."""
+    fast = closed_loop_rhs(lqr)                      # compiled, for the motions of periodic_motion
+
     def piece(lo, hi):
         def rhs(t, y):
+            if fast is not None:
+                return fast(t, y, _inside(t, lo, hi))
             x, u = _reference(lqr.motion, t, _inside(t, lo, hi))
             A, B = _jacobians(lqr.body, x, u)
             return ((A - B @ lqr._gain(t, x, u)) @ y.reshape(6, 6)).ravel()
