@@ -12,15 +12,12 @@ import pytest
 from lib import trajectories as T
 from lib.integrators import switched_events as E
 from lib.integrators.batch import dop853
-from lib.integrators import switched_compiled
 from lib.integrators.switched_compiled import dop853_dense
 from lib.limits import verdicts as L
 from lib.params import PAPER_DZ0, PAPER_Z0, Body, Gains
 
 EIGHT = T.eight()
 S0 = np.concatenate([PAPER_Z0, PAPER_DZ0])
-#: no reference table: every step computes the reference at its stages' times
-NO_TABLE = np.zeros((0, 12, 8))
 
 
 def _packed(body=Body(), gains=Gains(), ref=EIGHT):
@@ -35,7 +32,7 @@ def _smooth_step(dt):
     lim = (math.pi, -1.0, 0.0, math.inf)
     K, ys, y1, g = np.zeros((16, 6)), np.empty(6), np.empty(6), np.empty(4)
     E._field(P, lim, 1, 0.3, S0, K[0], g)
-    E._step(P, lim, 1, 0.3, S0, dt, tab.A, tab.b, tab.c, K, ys, y1, g, NO_TABLE, -1)
+    E._step(P, lim, 1, 0.3, S0, dt, tab.A, tab.b, tab.c, K, ys, y1, g)
     K[12] = ys
     return P, lim, tab, K, y1
 
@@ -51,7 +48,7 @@ def test_the_dense_output_and_its_continuation_agree_with_a_real_step(u):
     E._dense_coefficients(P, lim, 1, 0.3, S0, dt, y1, K, AX, CX, D, F, yh, gh)
     E._dense_state(F, S0, u, out)
     K2, ys, y2, g = K.copy(), np.empty(6), np.empty(6), np.empty(4)
-    E._step(P, lim, 1, 0.3, S0, u * dt, tab.A, tab.b, tab.c, K2, ys, y2, g, NO_TABLE, -1)
+    E._step(P, lim, 1, 0.3, S0, u * dt, tab.A, tab.b, tab.c, K2, ys, y2, g)
     # accuracy: the interpolant is of order 7 in dt = 0.04 s (local error ~ dt^8 x the 8th
     # derivative, O(1e-11) here), measured at most 6.7e-13 on [0, 1.05]; at u = 1 it is the step
     # itself up to rounding. A wrong coefficient of D moves it by dt x a rate, ~1e-2
@@ -61,27 +58,10 @@ def test_the_dense_output_and_its_continuation_agree_with_a_real_step(u):
 ROWS = dict(deg=[12, 20, 30, 45, 60, 90, 30, 45, 90], cap=[np.inf] * 6 + [4.0] * 3)
 
 
-def _rows(**options):
-    b, f = np.radians(ROWS["deg"]), np.array(ROWS["cap"])
-    return L.limit_verdicts(Body(), Gains(), EIGHT, b, f, **options)[0]
-
-
 @pytest.fixture(scope="module")
-def today():
-    """The rows as the book decides them: the dense locator, the reference read from its table."""
-    return _rows()
-
-
-@pytest.fixture(scope="module", params=["bracket locator", "reference computed at every stage"])
-def both(request, today):
-    """The rows decided another way, and as the book decides them: by the bracket locator (real
-    steps only), or with the reference's kinematics computed at every stage's time instead of read
-    from the period's table (``lib.integrators.switched_compiled.reference_table``)."""
-    if request.param == "bracket locator":
-        return {"bracket": _rows(locator="bracket"), "dense": today}
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(switched_compiled, "reference_table", lambda P, t0, period, n, c: np.zeros((0, c.size, 8)))
-        return {"bracket": _rows(), "dense": today}
+def both():
+    b, f = np.radians(ROWS["deg"]), np.array(ROWS["cap"])
+    return {loc: L.limit_verdicts(Body(), Gains(), EIGHT, b, f, locator=loc)[0] for loc in ("bracket", "dense")}
 
 
 def test_periodic_verdicts_their_orbits_and_multipliers_do_not_move(both):
@@ -90,14 +70,13 @@ def test_periodic_verdicts_their_orbits_and_multipliers_do_not_move(both):
     assert per.sum() >= 5 and (de.regime[per] == br.regime[per]).all() and (de.period[per] == br.period[per]).all()
     for i in np.flatnonzero(per):
         # accuracy: Newton stops at 1e-9 and every event is placed within 1e-11 s (x a jump of
-        # the rates < 10) by either locator; 1e-7 on the orbit's point (measured 4.4e-11; with and
-        # without the reference's table, whose values differ by rounding, 1.7e-11)
+        # the rates < 10) by either locator; 1e-7 on the orbit's point (measured 4.4e-11)
         assert np.abs(de.orbit[i] - br.orbit[i]).max() < 1e-7
         # accuracy: multipliers from a difference Jacobian with steps of 1e-6: good to ~1e-6
-        # (measured 1.9e-7; 5.7e-8 for the table); a wrong orbit moves them by its distance x the map's curvature
+        # (measured 1.9e-7); a wrong orbit moves them by its distance x the map's curvature
         assert abs(de.floquet[i] - br.floquet[i]) < 1e-5
         # accuracy: ranges read from the orbit sampled 40 times a period and refined: the orbit
-        # moves by < 1e-7, so does the range (measured 9.5e-12; 2.7e-12 for the table)
+        # moves by < 1e-7, so does the range (measured 9.5e-12)
         assert abs(de.p_range[i] - br.p_range[i]) < 1e-6 and abs(de.pos_err[i] - br.pos_err[i]) < 1e-6
 
 
@@ -109,8 +88,7 @@ def test_chaotic_statistics_move_only_within_their_standard_errors(both):
         # reason: no integrator follows a chaotic run point by point: a 1e-11 s move of one
         # event grows by e^(0.3 t); the exponent and the drift are batch means over 120 periods
         # with their batch-means errors, and the two estimates are independent; 4 combined
-        # standard errors (measured at most 1.15 for the exponent, 1.08 for the drift; with and
-        # without the table 0.96 and 1.33)
+        # standard errors (measured at most 1.15 for the exponent, 1.08 for the drift)
         se = math.hypot(de.lyapunov_stderr[i], br.lyapunov_stderr[i])
         assert abs(de.lyapunov[i] - br.lyapunov[i]) < 4 * se, (ROWS["deg"][i], de.lyapunov[i], br.lyapunov[i], se)
         se = math.hypot(de.drift_stderr[i], br.drift_stderr[i])
@@ -127,30 +105,6 @@ def test_the_dense_locator_lands_within_the_tolerance_of_the_bracket_one():
                               n_periods=1, locator=loc).states[:, -1] for loc in ("bracket", "dense")}
     # accuracy: 25 events x 1e-11 s x 10 = 2.5e-9 (measured 3.5e-13)
     assert np.abs(r["dense"] - r["bracket"]).max() < 2.5e-9
-
-
-def test_the_reference_table_holds_the_kernel_s_kinematics_and_moves_a_period_by_rounding():
-    P = _packed()
-    tab = dop853()
-    table = switched_compiled.reference_table(P, 0.0, EIGHT.period / 2, 100, tab.c)   # two samples a period
-    assert table.shape == (201, tab.c.size, 8)
-    for r, i in ((0, 0), (37, 5), (199, 11), (200, 0)):
-        t = r * (EIGHT.period / 200) + tab.c[i] * (EIGHT.period / 200)
-        # accuracy: the same formulas at the same time, numpy's cos and sin against libm's (terms of order 1,
-        # rounding of 1e-16)
-        np.testing.assert_allclose(table[r, i], switched_compiled._kin(P, t), rtol=1e-12, atol=1e-12)
-    # a kernel period that does not divide the path's: no table, every stage computed
-    assert switched_compiled.reference_table(P, 0.0, EIGHT.period / 2.5, 100, tab.c).shape[0] == 0
-    runs = {}
-    for table_on in (True, False):
-        with pytest.MonkeyPatch.context() as mp:
-            if not table_on:
-                mp.setattr(switched_compiled, "reference_table", lambda P, t0, period, n, c: np.zeros((0, c.size, 8)))
-            runs[table_on] = L.switched_runs(Body(), Gains(), EIGHT, np.radians([60.0, 90.0, 45.0]),
-                                             [np.inf, np.inf, 4.0], n_periods=1).states[:, -1]
-    # accuracy: the table's values differ from the stages' own by the rounding of their times, a
-    # relative 1e-15 or so, carried through one period with its 25 events (measured 7.5e-15)
-    assert np.abs(runs[True] - runs[False]).max() < 1e-11
 
 
 def test_an_unknown_locator_is_refused():

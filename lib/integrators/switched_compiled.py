@@ -9,10 +9,7 @@ modes (+1 / -1 smooth on a side, 0 sliding), by a different scheme:
 
 - every reference period T is cut into ``steps_per_period`` equal steps of an
   explicit Runge-Kutta method (8th-order Dormand-Prince by default), so that the
-  discrete period map is exactly T-periodic, as the flow's is. The reference's
-  kinematics at those steps' stages are tabulated once a call (:func:`reference_table`)
-  and read by every step taken whole from its grid time: two of the field's three sines
-  and cosines, a third of a run's time; a step's remainder after an event computes them;
+  discrete period map is exactly T-periodic, as the flow's is;
 - at the end of each step the event functions are evaluated
   (:mod:`lib.integrators.switched_field`): the switching function mode * lat + eps_lat
   (watched falling through zero), the sliding exits ``r_+ + k lat`` (rising) and
@@ -44,15 +41,12 @@ from pathlib import Path
 import numba
 import numpy as np
 
-from ..trajectories import circle_position, eight_position
 from .switched_events import T_TOL, _copy, _first_fired, _locate, _step
 from .switched_field import EPS_LAT, N_EVENTS, _field, _kin, _one_sided  # noqa: F401 (_kin: the tests')
 
 __all__ = ["run_periods", "dop853_dense", "EPS_LAT", "N_EVENTS", "T_TOL"]
 
 _MAX_EVENTS_PER_STEP = 200
-#: where P holds the path's size, rate and kind (``lib.integrators.switched_field``'s layout)
-_R_INDEX, _TH_INDEX, _KIND_INDEX = 9, 10, 12
 
 
 @numba.njit
@@ -87,12 +81,10 @@ def _new_mode(P, lim, mode, t, s, g0, g2, stats):
 
 @numba.njit
 def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2, yh, fh, gh, dense, AX, CX, D,
-             F, stats, tab, row0):
+             F, stats):
     """Integrate s (in place) over n_steps steps of size h from t0; returns the final mode.
     stats: [crossings, slides, time sliding, events, failed, steps locating events, dense
-    estimates rejected]; ``dense``: the locator (:mod:`lib.integrators.switched_events`).
-    A step taken whole from its grid time reads the reference from ``tab`` at row row0 + j
-    (:func:`reference_table`); a step's remainder after an event computes it."""
+    estimates rejected]; ``dense``: the locator (:mod:`lib.integrators.switched_events`)."""
     # K[0] holds the rates at (t, s) under the mode at every step's start (see _step): from the
     # field evaluated here or after an event, or from the end of the step before when that
     # step ended at the same time to the bit (t + dt == t_end), else evaluated again
@@ -108,7 +100,7 @@ def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2
             dt = t_end - t
             if dt <= 1e-13 * (1.0 + abs(t_end)):
                 break
-            _step(P, lim, mode, t, s, dt, A, b, c, K, ys, y1, g1, tab, row0 + j if n_ev == 0 and row0 >= 0 else -1)
+            _step(P, lim, mode, t, s, dt, A, b, c, K, ys, y1, g1)
             first = _first_fired(mode, g0, g1)
             if first < 0:
                 if mode == 0:
@@ -120,7 +112,7 @@ def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2
                 t = t_end
                 break
             hi = _locate(P, lim, mode, t, s, dt, first, A, b, c, K, ys, y1, y2, g0, g1, g2, yh, fh, gh, dense, AX, CX,
-                         D, F, stats, tab)
+                         D, F, stats)
             if mode == 0:
                 stats[2] += hi
             t += hi
@@ -156,12 +148,11 @@ def _make_run(stamp: int):
     a closure on its cells too, so an edit of any of them compiles it again."""
 
     @numba.njit(cache=True, parallel=True)
-    def _run(P, bmax, fmax, S0, n_periods, n_steps, T, t0, lyap_from, d0, A, b, c, dense, AX, CX, D, tab, sections,
+    def _run(P, bmax, fmax, S0, n_periods, n_steps, T, t0, lyap_from, d0, A, b, c, dense, AX, CX, D, sections,
              modes, logs, stats):
         if stamp < 0:
             return
         N = S0.shape[0]
-        n_tab = tab.shape[0] - 1                # the table's rows a reference period (none: 0)
         for q in numba.prange(N):
             K = np.empty((max(c.size, 16), 6))  # the stages, and for the dense output the end rates and three more
             F = np.empty((7, 6))
@@ -183,14 +174,13 @@ def _make_run(stamp: int):
                     for q6 in range(6):
                         s2[q6] = s[q6] + d0 / math.sqrt(6.0)
                     mode2 = _initial_mode(P, lim, ta, s2, g0, ys)
-                row0 = (k * n_steps) % n_tab if n_tab > 0 else -1   # the period's first row; -1: no table
                 mode = _advance(P, lim, mode, ta, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2, yh, fh, gh, dense,
-                                AX, CX, D, F, stats[q], tab, row0)
+                                AX, CX, D, F, stats[q])
                 if stats[q, 4] != 0.0:
                     break
                 if k >= lyap_from >= 0:
                     mode2 = _advance(P, lim, mode2, ta, s2, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1,
-                                     g2, yh, fh, gh, dense, AX, CX, D, F, st2, tab, row0)
+                                     g2, yh, fh, gh, dense, AX, CX, D, F, st2)
                     if st2[4] != 0.0:
                         stats[q, 4] = st2[4]
                         break
@@ -267,44 +257,8 @@ def run_periods(P: np.ndarray, angle_limits: np.ndarray, force_limits: np.ndarra
          np.ascontiguousarray(force_limits, float), np.ascontiguousarray(S0, float), int(n_periods),
          int(steps_per_period), float(period), float(t0), int(lyapunov_from), float(d0),
          np.ascontiguousarray(A, float), np.ascontiguousarray(b, float), np.ascontiguousarray(c, float),
-         dense_output is not None, AX, CX, D, reference_table(P, float(t0), float(period), int(steps_per_period), c),
-         sections, modes, logs, stats)
+         dense_output is not None, AX, CX, D, sections, modes, logs, stats)
     return sections, modes, logs, stats
-
-
-def reference_table(P: np.ndarray, t0: float, period: float, n_steps: int, c: np.ndarray) -> np.ndarray:
-    """The reference's position and its first three derivatives (the 8 values of ``_kin``) at
-    every stage of every step of one reference period, for the steps the integrator takes whole
-    from their grid time: (rows, stages, 8), row r at t0 + r h + c_i h (h = period / n_steps),
-    rows over one reference period 2 pi / |Theta| and one more (a step's end). The path is
-    periodic, so each period reads the same table: its values are those the kernel would
-    compute, at the stage times without the rounding that k T adds to them in period k.
-    Empty (0 rows) when ``period`` does not divide the reference's period into whole parts.
-
-    Parameters
-    ----------
-    P : numpy.ndarray
-        The packed parameters (:func:`run_periods`).
-    t0, period : float
-        The start time and the kernel's period (s).
-    n_steps : int
-        Steps a kernel period.
-    c : numpy.ndarray
-        The tableau's nodes.
-
-    Returns
-    -------
-    numpy.ndarray
-        The table (rows, stages, 8).
-    """
-    parts = 2 * math.pi / abs(P[_TH_INDEX]) / period
-    S = round(parts)
-    if S < 1 or abs(parts - S) > 1e-9 * S:
-        return np.zeros((0, c.size, 8))
-    h = period / n_steps
-    t = t0 + np.arange(S * n_steps + 1)[:, None] * h + np.asarray(c, float)[None, :] * h
-    kin = eight_position if P[_KIND_INDEX] == 1.0 else circle_position
-    return np.ascontiguousarray(np.stack(kin(P[_R_INDEX], P[_TH_INDEX], t), -1))
 
 
 def dop853_dense() -> tuple:

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numba
 
-from .switched_field import N_EVENTS, _field, _field_at
+from .switched_field import N_EVENTS, _field
 
 __all__ = ["T_TOL"]
 
@@ -46,22 +46,12 @@ _MARGIN = 1e-3
 
 
 @numba.njit
-def _tabled(tab, r, i):
-    """The reference's kinematics (the tuple of ``_kin``) tabulated at row r, stage i."""
-    k = tab[r, i]
-    return k[0], k[1], k[2], k[3], k[4], k[5], k[6], k[7]
-
-
-@numba.njit
-def _step(P, lim, mode, t, s, h, A, b, c, K, ys, out, g, tab, row):
+def _step(P, lim, mode, t, s, h, A, b, c, K, ys, out, g):
     """One explicit Runge-Kutta step of size h from (t, s) into ``out``; the event
     functions at its end into ``g``, the rates there into ``ys``. ``K[0]`` must hold the
     rates at (t, s) under ``mode`` already (the first stage, c[0] = 0, does not depend on
     h): the caller has them from the end of the step before, or from the field evaluated
-    after an event, or from the first try of this step (``_advance``). With ``row`` >= 0 the
-    step is a whole step of the period's grid and the reference is read from its table
-    ``tab`` (rows: the grid's steps; stages; the 8 values of ``_kin``; its end at the next
-    row's stage 0), else computed at each stage's time."""
+    after an event, or from the first try of this step (``_advance``)."""
     n_st = c.size
     for i in range(1, n_st):
         for q in range(6):
@@ -70,20 +60,14 @@ def _step(P, lim, mode, t, s, h, A, b, c, K, ys, out, g, tab, row):
             if A[i, j] != 0.0:
                 for q in range(6):
                     ys[q] += h * A[i, j] * K[j, q]
-        if row >= 0:
-            _field_at(P, lim, mode, _tabled(tab, row, i), ys, K[i], g)
-        else:
-            _field(P, lim, mode, t + c[i] * h, ys, K[i], g)
+        _field(P, lim, mode, t + c[i] * h, ys, K[i], g)
     for q in range(6):
         acc = 0.0
         for i in range(n_st):
             if b[i] != 0.0:
                 acc += b[i] * K[i, q]
         out[q] = s[q] + h * acc
-    if row >= 0:
-        _field_at(P, lim, mode, _tabled(tab, row + 1, 0), out, ys, g)
-    else:
-        _field(P, lim, mode, t + h, out, ys, g)
+    _field(P, lim, mode, t + h, out, ys, g)
 
 
 @numba.njit
@@ -197,7 +181,7 @@ def _dense_state(F, s, u, out):
 
 @numba.njit
 def _illinois(P, lim, mode, t, s, lo, hi, glo, ghi, ev, tol, dense, F, dt, A, b, c, K, ys, yt, gt,
-              y2, g2, g0, stats, tab):
+              y2, g2, g0, stats):
     """Narrow the bracket (lo, hi] (s from t) of the first event to ``tol``: the Illinois
     method on event ``ev`` (a bisection when it stalls), each try a real step from (t, s), or
     with ``dense`` the step's dense output F of length dt (no new stage). A secant try that
@@ -230,7 +214,7 @@ def _illinois(P, lim, mode, t, s, lo, hi, glo, ghi, ev, tol, dense, F, dt, A, b,
             _dense_state(F, s, th / dt, yt)
             _field(P, lim, mode, t + th, yt, ys, gt)
         else:
-            _step(P, lim, mode, t, s, th, A, b, c, K, ys, yt, gt, tab, -1)
+            _step(P, lim, mode, t, s, th, A, b, c, K, ys, yt, gt)
             stats[5] += 1
         hit = _hit(mode, g0, gt, ev)
         if hit >= 0:  # an event before th
@@ -259,7 +243,7 @@ def _illinois(P, lim, mode, t, s, lo, hi, glo, ghi, ev, tol, dense, F, dt, A, b,
 
 @numba.njit
 def _dense_landing(P, lim, mode, t, s, dt, first, A, b, c, K, ys, y1, y2, g0, g1, g2, yh, fh, gh, AX, CX, D,
-                   F, stats, tab):
+                   F, stats):
     """The dense locator (module docstring) for the step (t, s, dt) -> (y1, g1, end rates ys)
     where event ``first`` fired. Returns (lo, hi, glo, ghi, ev, done): done if the event is
     located (hi, with y2, g2 there), else the bracket (lo, hi] of event ev, its values glo,
@@ -273,7 +257,7 @@ def _dense_landing(P, lim, mode, t, s, dt, first, A, b, c, K, ys, y1, y2, g0, g1
     if not (0.0 < ta and guess < dt):
         stats[6] += 1
         return 0.0, dt, g0[ev], g2[ev], ev, False
-    _step(P, lim, mode, t, s, ta, A, b, c, K, ys, y1, g1, tab, -1)
+    _step(P, lim, mode, t, s, ta, A, b, c, K, ys, y1, g1)
     stats[5] += 1
     hit = _first_fired(mode, g0, g1)
     if hit >= 0:
@@ -293,7 +277,7 @@ def _dense_landing(P, lim, mode, t, s, dt, first, A, b, c, K, ys, y1, y2, g0, g1
         stats[6] += 1
         return ta, dt, ga[first], g2[first], first, False
     lo, hi, ev = _illinois(P, lim, mode, t, s, ta, tb, ga[ev], gh[ev], ev, _DENSE_TOL, True, F, ta, A, b, c, K,
-                           ys, yh, gh, y2, g2, g0, stats, tab)
+                           ys, yh, gh, y2, g2, g0, stats)
     # the event function's slope there, on the continuation over 1e-6 of the step
     th, tq = hi, hi - 1e-6 * dt
     _dense_state(F, s, th / ta, yh)
@@ -310,7 +294,7 @@ def _dense_landing(P, lim, mode, t, s, dt, first, A, b, c, K, ys, y1, y2, g0, g1
     lo_r, glo_r, hi_r = ta, ga[ev], dt  # the real bracket so far: not fired at ta; fired at dt (y2)
     for _ in range(2):
         th = min(root + 0.5 * T_TOL, hi_r)
-        _step(P, lim, mode, t, s, th, A, b, c, K, ys, y1, g1, tab, -1)
+        _step(P, lim, mode, t, s, th, A, b, c, K, ys, y1, g1)
         stats[5] += 1
         hit = _hit(mode, g0, g1, ev)
         if hit >= 0:
@@ -334,7 +318,7 @@ def _dense_landing(P, lim, mode, t, s, dt, first, A, b, c, K, ys, y1, y2, g0, g1
 
 @numba.njit
 def _locate(P, lim, mode, t, s, dt, first, A, b, c, K, ys, y1, y2, g0, g1, g2, yh, fh, gh, dense, AX, CX, D, F,
-            stats, tab):
+            stats):
     """The time from t (s) to the first event within a step dt from state s, where the event
     ``first`` fired at the step's end (y1, g1, with the end rates in ys): bracketed to T_TOL,
     on the dense output first if ``dense``. Returns it; y2, g2 hold the state and event
@@ -343,7 +327,7 @@ def _locate(P, lim, mode, t, s, dt, first, A, b, c, K, ys, y1, y2, g0, g1, g2, y
     ev = first
     if dense:
         lo, hi, glo, ghi, ev, done = _dense_landing(P, lim, mode, t, s, dt, first, A, b, c, K, ys, y1, y2, g0, g1,
-                                                    g2, yh, fh, gh, AX, CX, D, F, stats, tab)
+                                                    g2, yh, fh, gh, AX, CX, D, F, stats)
         if done:
             return hi
     else:
@@ -356,7 +340,7 @@ def _locate(P, lim, mode, t, s, dt, first, A, b, c, K, ys, y1, y2, g0, g1, g2, y
             for th in (guess - _MARGIN * dt, guess + _MARGIN * dt):
                 if not lo < th < hi:
                     continue
-                _step(P, lim, mode, t, s, th, A, b, c, K, ys, y1, g1, tab, -1)
+                _step(P, lim, mode, t, s, th, A, b, c, K, ys, y1, g1)
                 stats[5] += 1
                 hit = _first_fired(mode, g0, g1)
                 if hit >= 0:
@@ -370,5 +354,5 @@ def _locate(P, lim, mode, t, s, dt, first, A, b, c, K, ys, y1, y2, g0, g1, g2, y
                 lo = th
                 glo = g1[ev]
     lo, hi, ev = _illinois(P, lim, mode, t, s, lo, hi, glo, ghi, ev, T_TOL, False, F, dt, A, b, c, K, ys, y1, g1,
-                           y2, g2, g0, stats, tab)
+                           y2, g2, g0, stats)
     return hi

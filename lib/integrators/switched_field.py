@@ -43,15 +43,9 @@ def _kin(P, t):
 def _field(P, lim, mode, t, s, out, g):
     """Rates of state s under ``mode`` into ``out`` (6,), event functions into ``g`` (4,);
     ``lim`` = (beta_max, cos beta_max, sin beta_max, F_max)."""
-    return _field_at(P, lim, mode, _kin(P, t), s, out, g)
-
-
-@numba.njit
-def _field_at(P, lim, mode, kin, s, out, g):
-    """:func:`_field` with the reference's kinematics ``kin`` (the tuple of :func:`_kin`) given."""
     bmax, cb, sb, fmax = lim
     m, I, a, cc, cphi = P[_M], P[_I], P[_A], P[_C], P[_CPHI]
-    xd, yd, vxd, vyd, axd, ayd, jxd, jyd = kin
+    xd, yd, vxd, vyd, axd, ayd, jxd, jyd = _kin(P, t)
     x, y, phi, vx, vy, w = s[0], s[1], s[2], s[3], s[4], s[5]
     tx = m * axd + cc * vx + P[_KVX] * (vxd - vx) + P[_KPX] * (xd - x)
     ty = m * ayd + cc * vy + P[_KVY] * (vyd - vy) + P[_KPY] * (yd - y)
