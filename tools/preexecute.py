@@ -48,9 +48,9 @@ LAST = ("errata", "report", "intro")
 KERNEL_ENV = {"OPENBLAS_NUM_THREADS": "1"}
 #: a page's CPU time (s), measured (the log of ``make book`` from an empty ``_build``, 2026-11-27,
 #: after the compiled fields of Chapters 3, 6 and 8), to start the longest first (unknown pages first of all)
-COST = {"chapters/04_limits": 108, "chapters/05_stability": 89, "chapters/08_optimal": 57,
-        "chapters/03_tracking": 16, "chapters/06_allocation": 15, "chapters/07_percussion": 14,
-        "chapters/02_controllability": 10, "chapters/01_model": 3, "methods": 1}
+COST = {"chapters/04_limits": 106, "chapters/05_stability": 87, "chapters/08_optimal": 47,
+        "chapters/03_tracking": 17, "chapters/06_allocation": 14, "chapters/07_percussion": 13,
+        "chapters/02_controllability": 10, "chapters/01_model": 4, "methods": 1}
 
 
 def kernel_env(jobs: int, cores: int | None = None) -> dict:
