@@ -6,7 +6,9 @@ This is the single closed-loop right-hand side behind the smooth integrator
 (:func:`lib.weighting.batch.closed_loop_batch`); the switched integrator
 (:mod:`lib.integrators.switched`) uses a scalar fast path of the same equations,
 tested against this one at random states. :func:`paper_rates` is the paper's law on the
-circle or the eight compiled, for the smooth integrator's one state at a time.
+circle or the eight compiled, for the smooth integrator's one state at a time, and
+``_paper_rows_tabled`` the same law with a model and a tabulated reference per row, for the
+wrong-model loop (:mod:`lib.tracking.mismatch`); both allocate by one ``_position``.
 """
 
 from __future__ import annotations
@@ -120,6 +122,43 @@ class ClosedLoop:
 
 
 @numba.njit(cache=True)
+def _position(tx, ty, phi):  # pragma: no cover (compiled)
+    """(25)-(26) on one demand: F = |(tau_x, tau_y)| (N) and beta (rad) wrapped to (-pi, pi], 0
+    where F = 0 (``lib.allocation.allocate``, with :func:`lib.angles.wrap_angle`'s formula)."""
+    F = math.hypot(tx, ty)
+    beta = 0.0
+    if F > 0:
+        d = math.atan2(ty, tx) - phi
+        beta = math.pi - (math.pi - d) % (2 * math.pi)
+        if beta == -math.pi:
+            beta = math.pi
+    return F, beta
+
+
+@numba.njit(cache=True)
+def _paper_rows_tabled(ref, Y, T, model, k, plant, out):  # pragma: no cover (compiled)
+    """dy/dtau of the rows of Y (M, 6) in the normalised time tau = t / T (T (M,) the rows'
+    periods) under the paper's law without limits, each row with its own reference and model:
+    ``ref`` (9, M) the path's (z_d, dz_d, ddz_d) at the time, ``model`` (2, M) the model's m and
+    c in (23), k = (kp_x, kp_y, kv_x, kv_y), (2)-(4) of the plant (m, I, c, c_phi, a); the
+    operations of :meth:`ClosedLoop.rates`, in their order (tau_phi is not formed: (25)-(26) do
+    not read it). The wrong-model loop's field (:mod:`lib.tracking.mismatch`)."""
+    m, I, c, c_phi, a = plant[0], plant[1], plant[2], plant[3], plant[4]
+    for q in range(Y.shape[0]):
+        x, yy, phi, vx, vy, vp = Y[q, 0], Y[q, 1], Y[q, 2], Y[q, 3], Y[q, 4], Y[q, 5]
+        mx, cx = model[0, q], model[1, q]
+        tx = mx * ref[6, q] + cx * vx + k[2] * (ref[3, q] - vx) + k[0] * (ref[0, q] - x)     # (23)
+        ty = mx * ref[7, q] + cx * vy + k[3] * (ref[4, q] - vy) + k[1] * (ref[1, q] - yy)
+        F, beta = _position(tx, ty, phi)                                               # (25)-(26)
+        psi = phi + beta
+        Tq = T[q]
+        out[q, 0], out[q, 1], out[q, 2] = Tq * vx, Tq * vy, Tq * vp
+        out[q, 3] = Tq * ((F * math.cos(psi) - c * vx) / m)                             # (2)-(4)
+        out[q, 4] = Tq * ((F * math.sin(psi) - c * vy) / m)
+        out[q, 5] = Tq * ((F * math.sin(beta) * a - c_phi * vp) / I)
+
+
+@numba.njit(cache=True)
 def _paper_rows(t, Y, eight, R, Th, model, k, plant, fmax, bmax, out):  # pragma: no cover (compiled)
     """s' of the rows of Y (M, 6) under the paper's law: the path's position and derivatives
     (:func:`lib.trajectories.eight_position`, :func:`lib.trajectories.circle_position`), (23)
@@ -140,13 +179,7 @@ def _paper_rows(t, Y, eight, R, Th, model, k, plant, fmax, bmax, out):  # pragma
         x, y, phi, vx, vy, vp = Y[q, 0], Y[q, 1], Y[q, 2], Y[q, 3], Y[q, 4], Y[q, 5]
         tx = mm * axd + cm * vx + k[2] * (vxd - vx) + k[0] * (xd - x)                       # (23)
         ty = mm * ayd + cm * vy + k[3] * (vyd - vy) + k[1] * (yd - y)
-        F = math.hypot(tx, ty)                                                        # (25)-(26)
-        beta = 0.0
-        if F > 0:
-            d = math.atan2(ty, tx) - phi
-            beta = math.pi - (math.pi - d) % (2 * math.pi)            # lib.angles.wrap_angle's formula
-            if beta == -math.pi:
-                beta = math.pi
+        F, beta = _position(tx, ty, phi)                                              # (25)-(26)
         F = min(F, fmax)                                                              # Limits.apply
         beta = min(max(beta, -bmax), bmax)
         psi = phi + beta

@@ -20,16 +20,15 @@ Units: R in m, Theta in rad/s, errors in m, relative errors dimensionless.
 
 from __future__ import annotations
 
-import math
 from dataclasses import replace
 from typing import Mapping
 
-import numba
 import numpy as np
 import pandas as pd
 
 from ..machinery import checks
 from ..allocation import Limits
+from ..closed_loop import _paper_rows_tabled
 from ..dynamics import verdicts as dv
 from ..weighting.verdicts import _PeriodFlow, _decide, _loop_options, _observe, _start
 from ..machinery.parallel import concat_frames, map_chunks
@@ -163,35 +162,6 @@ def error_equation():
     return lhs, rhs, names
 
 
-@numba.njit(cache=True)
-def _mismatch_rows(ref, Y, T, model, k, plant, out):  # pragma: no cover (compiled)
-    """dy/dtau of the rows of Y (M, 6): (23) with each row's model m, c (``model`` (2, M)) and the
-    gains k = (kp_x, kp_y, kv_x, kv_y), the paper's allocation (25)-(26) without limits, and (2)-(4)
-    of the plant (m, I, c, c_phi, a); ``ref`` (9, M) the path at the stage's phase, T (M,) the
-    periods. The operations of :func:`lib.control.demand`, :func:`lib.allocation.allocate` and
-    :func:`lib.model.config_accel`, in their order (``tests/test_mismatch.py`` checks the field
-    against :class:`lib.closed_loop.ClosedLoop` with each point's model)."""
-    m, I, c, c_phi, a = plant[0], plant[1], plant[2], plant[3], plant[4]
-    for q in range(Y.shape[0]):
-        x, yy, phi, vx, vy, vp = Y[q, 0], Y[q, 1], Y[q, 2], Y[q, 3], Y[q, 4], Y[q, 5]
-        mx, cx = model[0, q], model[1, q]
-        tx = mx * ref[6, q] + cx * vx + k[2] * (ref[3, q] - vx) + k[0] * (ref[0, q] - x)     # (23)
-        ty = mx * ref[7, q] + cx * vy + k[3] * (ref[4, q] - vy) + k[1] * (ref[1, q] - yy)
-        F = math.hypot(tx, ty)                                                         # (25)-(26)
-        beta = 0.0
-        if F > 0:
-            d = math.atan2(ty, tx) - phi
-            beta = math.pi - (math.pi - d) % (2 * math.pi)         # lib.angles.wrap_angle's formula
-            if beta == -math.pi:
-                beta = math.pi
-        psi = phi + beta
-        Tq = T[q]
-        out[q, 0], out[q, 1], out[q, 2] = Tq * vx, Tq * vy, Tq * vp
-        out[q, 3] = Tq * ((F * math.cos(psi) - c * vx) / m)                             # (2)-(4)
-        out[q, 4] = Tq * ((F * math.sin(psi) - c * vy) / m)
-        out[q, 5] = Tq * ((F * math.sin(beta) * a - c_phi * vp) / I)
-
-
 class _MismatchFlow(_PeriodFlow):
     """The full closed loop's period map (:class:`lib.weighting.verdicts._PeriodFlow`, whose
     tables, sections and error map it keeps) with (23) computed from a model of its own
@@ -205,7 +175,8 @@ class _MismatchFlow(_PeriodFlow):
 
     def rates(self, idx):
         """dy/dtau of the rows ``idx``: (23) with each point's model, (25)-(26), (2)-(4), compiled
-        (:func:`_mismatch_rows`). tau_phi is not formed: the paper's allocation does not read it."""
+        (``lib.closed_loop._paper_rows_tabled``; ``tests/test_mismatch.py`` checks the field against
+        :class:`lib.closed_loop.ClosedLoop` with each point's model)."""
         b, g = self.body, self.gains
         T = np.ascontiguousarray(self.T[idx])
         table = np.ascontiguousarray(self.table[:, :, idx])                     # (2n, 9, M)
@@ -216,7 +187,7 @@ class _MismatchFlow(_PeriodFlow):
 
         def f(tau, y):
             out = np.empty((T.size, 6))
-            _mismatch_rows(table[self._phase(tau)[1]], np.ascontiguousarray(y, dtype=float), T, model, k, plant, out)
+            _paper_rows_tabled(table[self._phase(tau)[1]], np.ascontiguousarray(y, dtype=float), T, model, k, plant, out)
             return out
         return f
 
