@@ -1,4 +1,4 @@
-"""The compiled field of the weighted law under limits (lib.weighting.field) against the numpy
+"""The compiled field of the weighted law under limits (lib.closed_loop.limited_weighted_field) against the numpy
 closed loop it compiles (lib.closed_loop.ClosedLoop with the limited allocation)."""
 
 from __future__ import annotations
@@ -11,9 +11,8 @@ import pytest
 
 from lib import trajectories
 from lib.allocation import Allocation, Limits
-from lib.closed_loop import ClosedLoop, reference_of
+from lib.closed_loop import ClosedLoop, limited_weighted_field, reference_of
 from lib.params import Body, Gains
-from lib.weighting.field import limited_weighted_field
 
 BODY, GAINS = Body(), Gains()
 

@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from ..allocation import Allocation, Limits, allocate
-from ..closed_loop import ClosedLoop, reference_of
+from ..closed_loop import ClosedLoop, limited_weighted_field, reference_of
 from ..control import computed_torque
 from ..limits.runs import switched_runs
 from ..limits.verdicts import limit_verdicts
@@ -30,7 +30,6 @@ from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from ..percussion.full_loop import limited_field
 from ..percussion.law import ANTI_WINDUP_TIME, closed_loop_rates, error_polynomial
 from ..trajectories import POSITIONS, heading_turns, make
-from ..weighting.field import limited_weighted_field
 from .bound import cap_bound
 from .loop import FlowMap, loop_verdict, run_periods, steady_measures
 from .study import PAPER_CAP, SETTINGS, limit_motions, setting_label

@@ -20,13 +20,12 @@ import pandas as pd
 from ..machinery import checks
 from ..allocation import Allocation, Limits
 from ..angles import wrap_angle
-from ..closed_loop import ClosedLoop
+from ..closed_loop import ClosedLoop, _lean_rows
 from ..dynamics import verdicts as dv
 from ..integrators import batch
 from ..machinery.parallel import concat_frames, map_chunks
 from ..params import Body, Gains
 from ..trajectories import KINEMATICS
-from .field import _lean_rows
 
 __all__ = ["LOOP_VERDICT_DEFAULTS", "closed_loop_verdicts"]
 
@@ -157,7 +156,7 @@ class _PeriodFlow:
 
     def _field(self, idx):
         """The lean field of the rows ``idx`` as a function (tau, y), with everything that does not
-        change along the run gathered once; compiled (``lib.weighting.field._lean_rows``)."""
+        change along the run gathered once; compiled (``lib.closed_loop._lean_rows``)."""
         b, g = self.body, self.gains
         T = np.ascontiguousarray(self.T[idx])
         table, wind = np.ascontiguousarray(self.table[:, :, idx]), np.ascontiguousarray(self.wind[idx])  # (2n, 9, M)
