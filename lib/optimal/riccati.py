@@ -23,27 +23,26 @@ import numpy as np
 
 from ..params import Body
 from .collocation import tableau
+from .motion import NODE_SNAP
 
 __all__ = ["riccati_rhs", "closed_loop_rhs"]
 
-#: a node time computed in floating point belongs to the interval it starts (as :mod:`lib.optimal.motion`)
-_SNAP = 1e-9
 
 
 @numba.njit(cache=True)
-def _locate(t, period, nodes):  # pragma: no cover (compiled)
+def _locate(t, period, nodes, snap):  # pragma: no cover (compiled)
     """(interval, local time in [0, 1], whole periods) of t (s), as ``PeriodicMotion._locate``."""
     laps = math.floor(t / period)
     x = (t - laps * period) * (nodes / period)
-    k = min(max(int(math.floor(x + _SNAP)), 0), nodes - 1)
+    k = min(max(int(math.floor(x + snap)), 0), nodes - 1)
     return k, min(max(x - k, 0.0), 1.0), laps
 
 
 @numba.njit(cache=True)
-def _jac(t, t_in, period, nodes, turns, F, beta, basis, colloc, body):  # pragma: no cover (compiled)
+def _jac(t, t_in, period, nodes, snap, turns, F, beta, basis, colloc, body):  # pragma: no cover (compiled)
     """A (6, 6) and B (6, 2) of (2)-(4) about the motion's state at t and its inputs at t_in, as
     ``lib.optimal.tracker._reference`` and ``_jacobians`` compute them."""
-    k, s, laps = _locate(t, period, nodes)
+    k, s, laps = _locate(t, period, nodes, snap)
     d1 = basis.shape[0]
     x = np.zeros(6)
     for r in range(d1):                        # the Lagrange basis at s by Horner, then the state
@@ -54,7 +53,7 @@ def _jac(t, t_in, period, nodes, turns, F, beta, basis, colloc, body):  # pragma
             x[i] += w * colloc[k, r, i]
     x[2] += 2 * np.pi * turns * laps
     ti = t_in - math.floor(t_in / period) * period
-    ki = _locate(ti, period, nodes)[0]
+    ki = _locate(ti, period, nodes, snap)[0]
     f, b = F[ki], beta[ki]
     m, I, a, c, cphi = body[0], body[1], body[2], body[3], body[4]
     co, si = math.cos(x[2] + b), math.sin(x[2] + b)
@@ -72,9 +71,9 @@ def _jac(t, t_in, period, nodes, turns, F, beta, basis, colloc, body):  # pragma
 
 
 @numba.njit(cache=True)
-def _rhs(t, t_in, p, period, nodes, turns, F, beta, basis, colloc, body, Rinv, Q, out):  # pragma: no cover
+def _rhs(t, t_in, p, period, nodes, snap, turns, F, beta, basis, colloc, body, Rinv, Q, out):  # pragma: no cover
     """-P' at t for P = p (36,) into out (36,): the motion's state at t, its inputs at t_in."""
-    A, B = _jac(t, t_in, period, nodes, turns, F, beta, basis, colloc, body)
+    A, B = _jac(t, t_in, period, nodes, snap, turns, F, beta, basis, colloc, body)
     P = p.reshape(6, 6)
     M = A.T @ P + P @ A - P @ B @ Rinv @ np.ascontiguousarray(B.T) @ P + Q
     for i in range(6):
@@ -83,11 +82,11 @@ def _rhs(t, t_in, p, period, nodes, turns, F, beta, basis, colloc, body, Rinv, Q
 
 
 @numba.njit(cache=True)
-def _closed_rhs(t, t_in, y, period, nodes, turns, F, beta, basis, colloc, body, R, grid, PG, dPG,
+def _closed_rhs(t, t_in, y, period, nodes, snap, turns, F, beta, basis, colloc, body, R, grid, PG, dPG,
                 out):  # pragma: no cover (compiled)
     """(A - B K) Y at t for Y = y (36,) into out (36,), K = R^-1 B' P(t) with P(t) the cubic Hermite
     interpolant of the grid's P, dP (``PeriodicLQR.riccati``, ``PeriodicLQR._gain``)."""
-    A, B = _jac(t, t_in, period, nodes, turns, F, beta, basis, colloc, body)
+    A, B = _jac(t, t_in, period, nodes, snap, turns, F, beta, basis, colloc, body)
     s = np.mod(t, period)
     n = grid.size
     k = min(max(np.searchsorted(grid, s, side="right") - 1, 0), n - 2)
@@ -163,8 +162,8 @@ def closed_loop_rhs(lqr):
 
 
 def _motion_arrays(body: Body, motion) -> tuple:
-    """(period, nodes, turns, F, beta, basis, collocation, body) for the kernels."""
-    return (float(motion.period), int(motion.nodes), int(motion.turns),
+    """(period, nodes, the node snap, turns, F, beta, basis, collocation, body) for the kernels."""
+    return (float(motion.period), int(motion.nodes), float(NODE_SNAP), int(motion.turns),
             np.ascontiguousarray(motion.F, dtype=float), np.ascontiguousarray(motion.beta, dtype=float),
             np.ascontiguousarray(tableau(int(motion.degree)).basis, dtype=float),
             np.ascontiguousarray(motion.collocation, dtype=float),

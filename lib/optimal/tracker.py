@@ -287,9 +287,10 @@ def periodic_lqr(body: Body, motion, *, Q=None, R_weight=None, samples: int = 10
     fast = riccati_rhs(body, motion, Q, Rinv)      # compiled, for the motions of periodic_motion
 
     def piece(lo, hi):
+        if fast is not None:
+            return lambda t, p: fast(t, p, _inside(t, lo, hi))
+
         def rhs(t, p):
-            if fast is not None:
-                return fast(t, p, _inside(t, lo, hi))
             A, B = _jacobians(body, *_reference(motion, t, _inside(t, lo, hi)))
             return _riccati_rate(A, B, p.reshape(6, 6), Rinv, Q).ravel()
         return rhs
@@ -320,9 +321,10 @@ def _monodromy_multipliers(lqr: PeriodicLQR) -> np.ndarray:
     fast = closed_loop_rhs(lqr)                      # compiled, for the motions of periodic_motion
 
     def piece(lo, hi):
+        if fast is not None:
+            return lambda t, y: fast(t, y, _inside(t, lo, hi))
+
         def rhs(t, y):
-            if fast is not None:
-                return fast(t, y, _inside(t, lo, hi))
             x, u = _reference(lqr.motion, t, _inside(t, lo, hi))
             A, B = _jacobians(lqr.body, x, u)
             return ((A - B @ lqr._gain(t, x, u)) @ y.reshape(6, 6)).ravel()
