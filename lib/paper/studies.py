@@ -16,7 +16,7 @@ import pandas as pd
 from ..allocation import Limits
 from ..limits.attractors import heading_offset_starts, lyapunov_horizons, mirrored_start, start_attractors
 from ..limits.torus import NS_ANGLE_DEG, NS_START_CAP, torus_birth
-from ..limits.verdicts import limit_verdicts
+from ..limits.confirm import confirmed_limit_verdicts
 from ..machinery.cache import cached
 from ..optimal.compare import limits_study
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
@@ -73,9 +73,10 @@ def angle_sweep(body: Body, gains: Gains, cap):
     Returns
     -------
     LimitVerdicts
-        :func:`lib.limits.verdicts.limit_verdicts`' frame and runs.
+        :func:`lib.limits.confirm.confirmed_limit_verdicts`' frame (the verdicts confirmed from
+        moved starts) and runs.
     """
-    return cached(limit_verdicts, body, gains, eight(R0, THETA0), np.radians(SWEEP_DEG), cap)
+    return cached(confirmed_limit_verdicts, body, gains, eight(R0, THETA0), np.radians(SWEEP_DEG), cap)
 
 
 def torus(body: Body, gains: Gains):
