@@ -93,3 +93,21 @@ def test_a_frame_that_is_not_a_verdict_frame_is_refused(decided, change, match):
 def test_bad_options_are_refused_before_any_run(decided, kwargs, match):
     with pytest.raises((ValueError, TypeError), match=match):
         C.confirm_limit_verdicts(BODY, GAINS, EIGHT, decided, **kwargs)
+
+
+def test_verdicts_without_the_measures_are_the_same_verdicts(decided):
+    # measure=False skips only the second run that measures ranges: every verdict, period,
+    # multiplier, exponent and orbit is the same to the bit, the unmeasured columns are NaN or NA
+    lean = L.limit_verdicts(BODY, GAINS, EIGHT, np.radians([90.0, 60.0, 30.0]), measure=False)[0]
+    same = ["regime", "period", "turns", "floquet", "lyapunov", "lyapunov_stderr", "returns", "crossings", "reason"]
+    pd.testing.assert_frame_equal(lean[same], decided[same])
+    assert all(np.array_equal(a, b) for a, b in zip(lean.orbit[:2], decided.orbit[:2])) and lean.orbit[2] is None
+    assert lean[["p_range", "pos_err"]].isna().all().all()
+    # the orbits' drift is n / k without a run; the chaotic row's is not measured
+    assert list(lean.drift[:2]) == [0.0, 0.0] and np.isnan(lean.drift[2])
+    assert list(lean.lost[:2]) == [False, False] and lean.lost.isna()[2] and lean.turns_round.isna().all()
+
+
+def test_measure_must_be_a_flag():
+    with pytest.raises((TypeError, ValueError), match="measure"):
+        L.limit_verdicts(BODY, GAINS, EIGHT, np.radians([90.0]), measure="no")

@@ -88,15 +88,15 @@ def same_orbit(body: Body, gains: Gains, ref: Reference, angle_limits, force_lim
 
 
 def confirmed_limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force_limits=None, *, s0=None,
-                             steps_per_period: int = STEPS_PER_PERIOD, locator: str = "dense",
+                             steps_per_period: int = STEPS_PER_PERIOD, locator: str = "dense", measure: bool = True,
                              **options) -> LimitVerdicts:
     """:func:`lib.limits.verdicts.limit_verdicts`, its verdicts then confirmed by
     :func:`confirm_limit_verdicts` (the same arguments): Chapter 4's verdicts.
 
     Parameters
     ----------
-    body, gains, ref, angle_limits, force_limits, s0, steps_per_period, locator, **options
-        As for :func:`lib.limits.verdicts.limit_verdicts`.
+    body, gains, ref, angle_limits, force_limits, s0, steps_per_period, locator, measure, **options
+        As for :func:`lib.limits.verdicts.limit_verdicts` (``measure`` for the first decision only).
 
     Returns
     -------
@@ -104,7 +104,7 @@ def confirmed_limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_lim
         ``frame`` confirmed (with the column ``confirmed``) and ``runs``, the first decision's.
     """
     frame, runs = limit_verdicts(body, gains, ref, angle_limits, force_limits, s0=s0,
-                                 steps_per_period=steps_per_period, locator=locator, **options)
+                                 steps_per_period=steps_per_period, locator=locator, measure=measure, **options)
     return LimitVerdicts(confirm_limit_verdicts(body, gains, ref, frame, s0=s0, steps_per_period=steps_per_period,
                                                 locator=locator, **options), runs)
 

@@ -88,8 +88,8 @@ class _SwitchedMap:
 
 
 def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force_limits=None, *, s0=None,
-                   steps_per_period: int = STEPS_PER_PERIOD, locator: str = "dense", executor=None,
-                   chunk_size: int | None = None, progress: bool | None = None, **options):
+                   steps_per_period: int = STEPS_PER_PERIOD, locator: str = "dense", measure: bool = True,
+                   executor=None, chunk_size: int | None = None, progress: bool | None = None, **options):
     """Decide the long-run regime of the switched closed loop for each (angle limit (rad),
     force limit (N)) pair by the book's one decision procedure (:mod:`lib.dynamics.verdicts`)
     on the full state. Options (:data:`LIMIT_DEFAULTS`): ``transient`` periods dropped,
@@ -149,6 +149,12 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
         Fixed steps per reference period of the compiled integrator (>= 16).
     locator : {"dense", "bracket"}
         How the compiled integrator locates events (:mod:`lib.integrators.switched_events`).
+    measure : bool
+        Whether to take the measures over the whole orbit or run (a second run of each pair,
+        about a fifth of the cost). False, for a caller that reads only the verdicts: p_range,
+        pos_err, drift and drift_stderr are NaN without an orbit (an orbit's drift is still
+        n / k), lost is NA without an orbit and turns_round NA everywhere (pandas' nullable
+        booleans); the verdicts, periods, multipliers, exponents and orbits are the same.
     executor : concurrent.futures.Executor, optional
         Where the chunks of pairs run (a process pool, a dask ``Client.get_executor()``).
     chunk_size : int, optional
@@ -173,8 +179,10 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
     locator = checks.one_of("locator", locator, LOCATORS)
     b, f = _limits_arrays(angle_limits, force_limits)
     S0 = _start_states(s0, b.size)
+    measure = checks.flag("measure", measure)
     parts = map_chunks(_limit_chunk, b.size, (b, f, S0), dict(body=body, gains=gains, ref=ref, o=o,
-                                                             steps_per_period=steps_per_period, locator=locator),
+                                                             steps_per_period=steps_per_period, locator=locator,
+                                                             measure=measure),
                        executor, chunk_size, progress)
     if len(parts) == 1:
         return LimitVerdicts(*parts[0])
@@ -200,7 +208,7 @@ def _section_orbits(pmap: _SwitchedMap, states: np.ndarray, o: dict):
     return orb, step, hist
 
 
-def _limit_chunk(b, f, S0, *, body, gains, ref, o, steps_per_period, locator):
+def _limit_chunk(b, f, S0, *, body, gains, ref, o, steps_per_period, locator, measure=True):
     """(frame, runs) of :func:`limit_verdicts` for validated pairs (one chunk of them)."""
     ntr, npr, blk, kmax = o["transient"], o["periods"], o["block"], o["max_period"]
     runs = switched_runs(body, gains, ref, b, f, s0=S0, n_periods=ntr + npr,
@@ -227,7 +235,7 @@ def _limit_chunk(b, f, S0, *, body, gains, ref, o, steps_per_period, locator):
     mu[found] = orb["rho"][found]
     regime[found] = dv.orbit_regime(orb["n"][found])
     reason[found] = ""
-    m = _over_the_run(pmap, runs.states[:, ntr], orb, npr, blk)
+    m = _over_the_run(pmap, runs.states[:, ntr], orb, npr, blk) if measure else _orbit_measures(orb)
     lost = dv.heading_lost(found, orb["n"], m["drift"], m["drift_stderr"], slip_band=o["slip_band"])
     frame = pd.DataFrame(dict(
         angle_limit=runs.angle_limit, angle_deg=np.degrees(runs.angle_limit), force_limit=runs.force_limit,
@@ -236,7 +244,21 @@ def _limit_chunk(b, f, S0, *, body, gains, ref, o, steps_per_period, locator):
         drift_stderr=m["drift_stderr"], lost=lost, turns_round=dv.turns_round(m["p_range"]),
         crossings=runs.crossings, slides=runs.slides, t_sliding=runs.t_sliding, reason=reason,
         orbit=[orb["x"][q].copy() if found[q] else None for q in range(N)]))
+    if not measure:
+        frame["lost"] = pd.array(np.where(found, lost, False), dtype="boolean")
+        frame.loc[~found, "lost"] = pd.NA
+        frame["turns_round"] = pd.array([pd.NA] * N, dtype="boolean")
     return frame, runs
+
+
+def _orbit_measures(orb: dict) -> dict:
+    """The measures of :func:`limit_verdicts` without the run that takes them (``measure``
+    False): NaN, except an orbit's drift, n / k turns a period with no error."""
+    N = orb["found"].size
+    out = {key: np.full(N, np.nan) for key in ("p_range", "pos_err", "drift", "drift_stderr")}
+    f = orb["found"]
+    out["drift"][f], out["drift_stderr"][f] = orb["n"][f] / orb["k"][f], 0.0
+    return out
 
 
 #: samples per reference period of the runs that measure ranges over a whole orbit or run
@@ -312,7 +334,7 @@ def extend_undecided(body: Body, gains: Gains, ref: Reference, frame: pd.DataFra
     steps_per_period : int
         Fixed steps per period.
     **options
-        The options of :func:`limit_verdicts`.
+        The options of :func:`limit_verdicts` (:data:`LIMIT_DEFAULTS`, and its ``measure``).
 
     Returns
     -------
