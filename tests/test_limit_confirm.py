@@ -47,7 +47,17 @@ def test_an_orbit_recorded_for_a_chaotic_run_makes_it_transient(decided):
     row = decided.iloc[[0]].copy()
     row["angle_limit"] = decided.angle_limit.iloc[2]
     out = C.confirm_limit_verdicts(BODY, GAINS, EIGHT, row).iloc[0]
-    assert out.regime == "transient" and "no orbit" in out.reason
+    assert out.regime == "transient" and out.reason.endswith("start + 1e-12: chaotic)")
+
+
+def test_a_chaotic_verdict_whose_moved_start_reaches_an_orbit_is_transient(decided):
+    # the 90 deg row said to be chaotic: the moved start reaches the period-1 orbit, another
+    # regime, so the attractor is not determined
+    row = decided.iloc[[0]].copy()
+    row["regime"], row["period"], row["turns"] = "chaotic", 0, 0
+    row.at[row.index[0], "orbit"] = None
+    out = C.confirm_limit_verdicts(BODY, GAINS, EIGHT, row).iloc[0]
+    assert out.regime == "transient" and out.reason.endswith("start + 1e-12: periodic, period 1)")
 
 
 def test_runs_claiming_no_attractor_and_confirmed_rows_are_left_alone(decided):

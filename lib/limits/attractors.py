@@ -28,6 +28,7 @@ import pandas as pd
 
 from ..machinery import checks
 from ..dynamics import verdicts as dv
+from .confirm import SAME_ORBIT_TOL, confirm_limit_verdicts
 from .verdicts import LIMIT_DEFAULTS, limit_verdicts
 from .runs import STEPS_PER_PERIOD, switched_runs
 from ..integrators.switched import SwitchedLoop
@@ -41,10 +42,6 @@ __all__ = ["MIRROR", "mirror_state", "half_period_mirror", "mirror_defect", "mir
 #: The mirror sigma on a state [x, y, phi, xdot, ydot, phidot], as signs, (x, -y, -phi) and their rates.
 MIRROR = np.array([1.0, -1.0, -1.0, 1.0, -1.0, -1.0])
 
-#: two located orbits are the same when every point of one lies this close (max-norm, the
-#: heading modulo 2 pi) to a point of the other: Newton locates them to 1e-9, distinct
-#: orbits of Chapter 4 lie at least 0.5 apart
-SAME_ORBIT_TOL = 1e-6
 
 
 def _check_loop(body, gains, ref, angle_limit, force_limit) -> tuple[float, float]:
@@ -208,10 +205,12 @@ def start_attractors(body: Body, gains: Gains, ref: Eight, angle_limit: float, f
     """Which attractor each start reaches, and its mirror.
 
     Each start (at t = 0) is decided by :func:`lib.limits.verdicts.limit_verdicts` (``options`` as
-    there). The orbits reached are then named in the order of the starts: the first is A,
+    there), and confirmed from the start moved by 1e-12
+    (:func:`lib.limits.confirm.confirm_limit_verdicts`: ``transient`` where the decisions differ).
+    The orbits reached are then named in the order of the starts: the first is A,
     the next distinct one B, ...; an orbit that is the mirror G(X) of an orbit X named
     before (G from :func:`half_period_mirror`) is named X' (A' is the mirror of A). Two
-    orbits are the same when each point of one lies within :data:`SAME_ORBIT_TOL` of the
+    orbits are the same when each point of one lies within :data:`lib.limits.confirm.SAME_ORBIT_TOL` of the
     other's points. An orbit equal to its own mirror is symmetric.
 
     Parameters
@@ -237,6 +236,7 @@ def start_attractors(body: Body, gains: Gains, ref: Eight, angle_limit: float, f
     x = _states("starts", starts)
     fr = limit_verdicts(body, gains, ref, np.full(len(x), b), np.full(len(x), f), s0=x,
                         steps_per_period=steps_per_period, **options)[0]
+    fr = confirm_limit_verdicts(body, gains, ref, fr, s0=x, steps_per_period=steps_per_period, **options)
     named: list[tuple[str, np.ndarray]] = []         # (name, the orbit's points)
     names, sym, gap = [], [], []
     for q, row in enumerate(fr.itertuples()):

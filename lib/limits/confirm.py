@@ -6,12 +6,13 @@ Every run of :func:`lib.limits.verdicts.limit_verdicts` goes on past its transie
 Lyapunov run, and its orbit, if any, is located on the section observed after the transient.
 So every run that claims an attractor (periodic, slipping or chaotic) meets the trigger of
 :func:`lib.dynamics.verdicts.needs_confirmation`. Some of these runs wander for tens of periods
-before they settle: on the eight without a cap, at 51 degrees the paper's start reaches its
-period-3 orbit only after 58 periods, and a start moved by a relative 1e-12 is still chaotic
-after 180. Such a verdict is decided by the last bits of the trajectory, and a reader's machine
-may print another one. :func:`confirm_limit_verdicts` decides these runs again from the start
-moved by :data:`lib.machinery.robustness.ROBUST_REL` and names ``transient`` the runs whose two
-decisions reach different attractors (:func:`lib.dynamics.verdicts.attractor_determined`).
+before they settle, and a start moved by a relative 1e-12 may settle elsewhere, or not within
+the horizon; a chaotic run whose exponent clears its threshold by little may, from a moved
+start, not clear it. Such a verdict is decided by the last bits of the trajectory, and a
+reader's machine may print another one. :func:`confirm_limit_verdicts` decides these runs
+again from the start moved by :data:`lib.machinery.robustness.ROBUST_REL` and names
+``transient`` the runs whose decisions differ (:func:`lib.dynamics.verdicts.attractor_determined`,
+the rule Chapter 5's :func:`lib.rotation.fig5.confirm_attractors` applies).
 
 Units: angles in rad, forces in N, states [x, y, phi, xdot, ydot, phidot] in m, rad, m/s, rad/s.
 """
@@ -26,11 +27,17 @@ from ..machinery import checks
 from ..machinery.robustness import ROBUST_REL, perturbed
 from ..params import Body, Gains
 from ..trajectories import Reference
-from .attractors import SAME_ORBIT_TOL
 from .runs import LOCATORS, STEPS_PER_PERIOD, _check_parts, _start_states, switched_runs
-from .verdicts import LIMIT_DEFAULTS, LimitVerdicts, _section_orbits, _SwitchedMap, limit_verdicts
+from .verdicts import LIMIT_DEFAULTS, LimitVerdicts, _limit_chunk, _SwitchedMap, limit_verdicts
 
-__all__ = ["confirmed_limit_verdicts", "confirm_limit_verdicts", "same_orbit", "MOVES", "QUICK_PERIODS"]
+__all__ = ["confirmed_limit_verdicts", "confirm_limit_verdicts", "same_orbit", "SAME_ORBIT_TOL", "MOVES",
+           "QUICK_PERIODS"]
+
+#: two located orbits are the same when every point of one lies this close (max-norm, the
+#: heading modulo 2 pi) to a point of the other: Newton locates them to 1e-9, distinct
+#: orbits of Chapter 4 lie at least 0.5 apart (:func:`same_orbit`; re-exported by
+#: :mod:`lib.limits.attractors`, which names orbits by it)
+SAME_ORBIT_TOL = 1e-6
 
 #: the relative moves of the start (:func:`lib.machinery.robustness.perturbed`) from which a run is
 #: decided again: ROBUST_REL with the fixed pseudo-random signs, as Chapter 5 moves its starts
@@ -51,7 +58,7 @@ _NEEDED = ("angle_limit", "force_limit", "regime", "period", "turns", "orbit")
 def same_orbit(body: Body, gains: Gains, ref: Reference, angle_limits, force_limits, first, second, period, *,
                steps_per_period: int = STEPS_PER_PERIOD, locator: str = "dense") -> np.ndarray:
     """Whether two located orbits of the switched loop, of the same ``period`` k, are one:
-    the point ``second`` (M, 6) lies within :data:`lib.limits.attractors.SAME_ORBIT_TOL`
+    the point ``second`` (M, 6) lies within :data:`SAME_ORBIT_TOL`
     (max-norm, the heading modulo 2 pi) of one of the k points P^j(``first``), j = 1..k, of
     the orbit through ``first`` (M, 6). Newton locates both to about 1e-9; distinct orbits
     of Chapter 4 lie 0.5 or more apart. Returns (M,) bool.
@@ -110,7 +117,9 @@ def confirmed_limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_lim
 
 
 def _describe(regime, period, turns) -> str:
-    """An orbit's words: its regime and period, and its turns where it slips."""
+    """A decision's words: its regime, and on an orbit its period and its turns where it slips."""
+    if regime not in dv.ORBIT_REGIMES:
+        return regime
     return f"{regime}, period {period}" + (f", {turns:+d} turns" if turns else "")
 
 
@@ -124,17 +133,16 @@ def confirm_limit_verdicts(body: Body, gains: Gains, ref: Reference, frame: pd.D
     run here is observed past its transient) is decided again over the same horizon from its
     start moved by each relative move of :data:`MOVES` (:func:`lib.machinery.robustness.perturbed`).
 
-    The attractor a run reaches is its orbit, or none. A moved run whose first decision
-    located an orbit and that reaches that orbit within :data:`QUICK_PERIODS` periods (by the
-    procedure's own test, :func:`lib.dynamics.verdicts.reached`) reaches the same attractor;
-    every other moved run is followed over the whole horizon and its orbit sought as the
-    procedure seeks it. The attractors differ where one run has an orbit and the other none,
-    or both have orbits of another period, other turns or other points (:func:`same_orbit`);
-    there (:func:`lib.dynamics.verdicts.attractor_determined`) the verdict becomes
+    A moved run whose first decision located an orbit and that reaches that orbit within
+    :data:`QUICK_PERIODS` periods (by the procedure's own test,
+    :func:`lib.dynamics.verdicts.reached`) reaches the same attractor; every other moved run
+    is decided in full, over the whole horizon (the procedure of
+    :func:`lib.limits.verdicts.limit_verdicts`, without its measures over the run). Where the
+    decisions differ (:func:`lib.dynamics.verdicts.attractor_determined`: another regime,
+    such as chaotic against undecided or an orbit against none, another period, or, on
+    orbits, other turns or other points, :func:`same_orbit`) the verdict becomes
     ``transient``, its period and turns 0, its orbit None, and its reason lists the
-    decisions; the other columns keep the first decision's numbers. A run that reaches no
-    orbit is not decided again between chaotic, quasi-periodic and undecided: those words
-    rest on the exponent's statistics and their standard errors, not on one trajectory.
+    decisions; the other columns keep the first decision's numbers.
 
     Column ``confirmed``: the moved starts from which the run was decided again
     (len(:data:`MOVES`)), 0 where not (undecided and quasi-periodic runs). Rows already
@@ -212,53 +220,45 @@ def _reaches(frame, g, body, gains, ref, moved, o, steps_per_period, locator) ->
     return dv.reached(d_now, d_then, rho, m / k, tol=o["approach_tol"], floor=o["reach_tol"])
 
 
-def _orbits_from(frame, g, body, gains, ref, moved, o, steps_per_period, locator) -> dict:
-    """The attracting orbit (if any) that each run from ``moved`` (M, 6) reaches over the
-    horizon of the rows ``g`` (the procedure's transient and periods, ``o``), found as
-    :func:`lib.limits.verdicts.limit_verdicts` finds it; the dict of
-    :func:`lib.dynamics.verdicts.find_orbits` (its turns counted against the path's heading)."""
-    b, f = frame.angle_limit.to_numpy()[g], frame.force_limit.to_numpy()[g]
-    states = switched_runs(body, gains, ref, b, f, s0=moved, n_periods=o["transient"] + o["periods"],
-                           steps_per_period=steps_per_period, locator=locator).states
-    return _section_orbits(_SwitchedMap(body, gains, ref, b, f, steps_per_period, locator), states, o)[0]
-
-
 def _confirm_rows(out, frame, g, body, gains, ref, S0, o, steps_per_period, locator) -> None:
     """The rows ``g`` of ``frame`` decided again from their starts ``S0`` (M, 6) moved by each
     of :data:`MOVES`, as :func:`confirm_limit_verdicts` says (all moves in one batch of runs);
     ``confirmed`` and the ``transient`` verdicts written into ``out`` (in place)."""
     out.iloc[g, out.columns.get_loc("confirmed")] = len(MOVES)
     r1, k1, n1 = (frame[c].to_numpy()[g] for c in ("regime", "period", "turns"))
-    has1 = np.isin(r1, dv.ORBIT_REGIMES)
     # the batch: every row once per move, (D M,), the moves slowest
-    G, K1, N1, H1 = np.tile(g, len(MOVES)), np.tile(k1, len(MOVES)), np.tile(n1, len(MOVES)), np.tile(has1, len(MOVES))
+    D = len(MOVES)
+    G, R1, K1, N1 = np.tile(g, D), np.tile(r1, D), np.tile(k1, D), np.tile(n1, D)
     moved = np.concatenate([[perturbed(s, rel) for s in S0] for rel in MOVES])
-    K2, N2, H2 = K1.copy(), N1.copy(), H1.copy()
+    R2, K2, N2 = R1.copy(), K1.copy(), N1.copy()
     same = np.ones(G.size, bool)
+    has1 = np.isin(R1, dv.ORBIT_REGIMES)
     quick = np.zeros(G.size, bool)
-    if H1.any():
-        quick[H1] = _reaches(frame, G[H1], body, gains, ref, moved[H1], o, steps_per_period, locator)
+    if has1.any():
+        quick[has1] = _reaches(frame, G[has1], body, gains, ref, moved[has1], o, steps_per_period, locator)
     full = np.flatnonzero(~quick)
     if full.size:
-        orb = _orbits_from(frame, G[full], body, gains, ref, moved[full], o, steps_per_period, locator)
-        H2[full], K2[full], N2[full] = orb["found"], orb["k"], orb["n"]
-        same[full] = H1[full] == orb["found"]
-        pair = H1[full] & orb["found"] & (orb["k"] == K1[full]) & (orb["n"] == N1[full])
-        same[full[H1[full] & ~pair]] = False
-        both = full[pair]
-        if both.size:
+        b, f = frame.angle_limit.to_numpy()[G[full]], frame.force_limit.to_numpy()[G[full]]
+        redo = _limit_chunk(b, f, moved[full], body=body, gains=gains, ref=ref, o=o,
+                            steps_per_period=steps_per_period, locator=locator, measure=False)[0]
+        R2[full], K2[full], N2[full] = (redo[c].to_numpy() for c in ("regime", "period", "turns"))
+        pair = np.flatnonzero(np.isin(R1[full], dv.ORBIT_REGIMES) & (R2[full] == R1[full]) & (K2[full] == K1[full])
+                              & (N2[full] == N1[full]))
+        same[full] = False
+        if pair.size:
+            both = full[pair]
             first = np.stack([frame.orbit.iloc[q] for q in G[both]])
-            b, f = frame.angle_limit.to_numpy()[G[both]], frame.force_limit.to_numpy()[G[both]]
-            same[both] = same_orbit(body, gains, ref, b, f, first, orb["x"][pair], K1[both],
-                                    steps_per_period=steps_per_period, locator=locator)
-    same, H2, K2, N2 = (v.reshape(len(MOVES), g.size) for v in (same, H2, K2, N2))
-    for j in np.flatnonzero(~same.all(axis=0)):
-        words = [f"the start: {_describe(r1[j], k1[j], n1[j]) if has1[j] else 'no orbit (' + r1[j] + ')'}"]
+            same[both] = same_orbit(body, gains, ref, b[pair], f[pair], first, np.stack(redo.orbit.iloc[pair]),
+                                    K1[both], steps_per_period=steps_per_period, locator=locator)
+    ok = dv.attractor_determined([r1] + list(R2.reshape(D, -1)), [k1] + list(K2.reshape(D, -1)),
+                                 same.reshape(D, -1))
+    R2, K2, N2, same = (v.reshape(D, -1) for v in (R2, K2, N2, same))
+    for j in np.flatnonzero(~ok):
+        words = [f"the start: {_describe(r1[j], k1[j], n1[j])}"]
         for d, rel in enumerate(MOVES):
-            words.append(f"start {'+' if rel > 0 else '-'} 1e-12: "
-                         + (_describe(dv.orbit_regime(N2[d, j : j + 1])[0], K2[d, j], N2[d, j]) if H2[d, j] else "no orbit")
-                         + (", another orbit" if has1[j] and H2[d, j] and (K2[d, j], N2[d, j]) == (k1[j], n1[j])
-                            and not same[d, j] else ""))
+            other = (R2[d, j], K2[d, j], N2[d, j]) == (r1[j], k1[j], n1[j]) and not same[d, j]
+            words.append(f"start {'+' if rel > 0 else '-'} 1e-12: {_describe(R2[d, j], K2[d, j], N2[d, j])}"
+                         + (", another orbit" if other else ""))
         i = frame.index[g[j]]
         out.loc[i, ["regime", "period", "turns", "reason"]] = [
             dv.TRANSIENT, 0, 0, "transient chaos: attractor not determined (" + "; ".join(words) + ")"]
