@@ -121,3 +121,11 @@ def test_verdicts_without_the_measures_are_the_same_verdicts(decided):
 def test_measure_must_be_a_flag():
     with pytest.raises((TypeError, ValueError), match="measure"):
         L.limit_verdicts(BODY, GAINS, EIGHT, np.radians([90.0]), measure="no")
+
+
+def test_same_orbit_refuses_bad_limits_and_periods(decided):
+    x = decided.orbit.iloc[0]
+    with pytest.raises(ValueError, match="angle_limits"):
+        C.same_orbit(BODY, GAINS, EIGHT, [4.0], [np.inf], [x], [x], [1])
+    with pytest.raises(ValueError, match="period"):
+        C.same_orbit(BODY, GAINS, EIGHT, [1.0], [np.inf], [x], [x], [0])

@@ -28,8 +28,8 @@ import pandas as pd
 
 from ..machinery import checks
 from ..dynamics import verdicts as dv
-from .confirm import SAME_ORBIT_TOL, confirm_limit_verdicts
-from .verdicts import LIMIT_DEFAULTS, limit_verdicts
+from .confirm import SAME_ORBIT_TOL, confirmed_limit_verdicts
+from .verdicts import LIMIT_DEFAULTS
 from .runs import STEPS_PER_PERIOD, switched_runs
 from ..integrators.switched import SwitchedLoop
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
@@ -206,7 +206,7 @@ def start_attractors(body: Body, gains: Gains, ref: Eight, angle_limit: float, f
 
     Each start (at t = 0) is decided by :func:`lib.limits.verdicts.limit_verdicts` (``options`` as
     there), and confirmed from the start moved by 1e-12
-    (:func:`lib.limits.confirm.confirm_limit_verdicts`: ``transient`` where the decisions differ).
+    (:func:`lib.limits.confirm.confirmed_limit_verdicts`: ``transient`` where the decisions differ).
     The orbits reached are then named in the order of the starts: the first is A,
     the next distinct one B, ...; an orbit that is the mirror G(X) of an orbit X named
     before (G from :func:`half_period_mirror`) is named X' (A' is the mirror of A). Two
@@ -234,9 +234,8 @@ def start_attractors(body: Body, gains: Gains, ref: Eight, angle_limit: float, f
     """
     b, f = _check_loop(body, gains, ref, angle_limit, force_limit)
     x = _states("starts", starts)
-    fr = limit_verdicts(body, gains, ref, np.full(len(x), b), np.full(len(x), f), s0=x,
-                        steps_per_period=steps_per_period, **options)[0]
-    fr = confirm_limit_verdicts(body, gains, ref, fr, s0=x, steps_per_period=steps_per_period, **options)
+    fr = confirmed_limit_verdicts(body, gains, ref, np.full(len(x), b), np.full(len(x), f), s0=x,
+                                  steps_per_period=steps_per_period, **options)[0]
     named: list[tuple[str, np.ndarray]] = []         # (name, the orbit's points)
     names, sym, gap = [], [], []
     for q, row in enumerate(fr.itertuples()):

@@ -27,7 +27,7 @@ from ..machinery import checks
 from ..machinery.robustness import ROBUST_REL, perturbed
 from ..params import Body, Gains
 from ..trajectories import Reference
-from .runs import LOCATORS, STEPS_PER_PERIOD, _check_parts, _start_states, switched_runs
+from .runs import LOCATORS, STEPS_PER_PERIOD, _check_parts, _limits_arrays, _start_states, switched_runs
 from .verdicts import LIMIT_DEFAULTS, LimitVerdicts, _limit_chunk, _SwitchedMap, limit_verdicts
 
 __all__ = ["confirmed_limit_verdicts", "confirm_limit_verdicts", "same_orbit", "SAME_ORBIT_TOL", "MOVES",
@@ -83,12 +83,13 @@ def same_orbit(body: Body, gains: Gains, ref: Reference, angle_limits, force_lim
     numpy.ndarray
         (M,) bool.
     """
+    _check_parts(body, gains, ref)
     first = np.atleast_2d(checks.array("first", first, shape=(..., 6)))
     second = np.atleast_2d(checks.array("second", second, shape=first.shape))
     k = np.broadcast_to(np.asarray(period, dtype=int), (first.shape[0],))
     if np.any(k < 1):
         raise ValueError(f"period must be >= 1, got {k.min()}")
-    b, f = (np.broadcast_to(np.asarray(v, dtype=float), k.shape) for v in (angle_limits, force_limits))
+    b, f = (np.broadcast_to(v, k.shape) for v in _limits_arrays(angle_limits, force_limits))
     pmap = _SwitchedMap(body, gains, ref, b, f, steps_per_period, locator)
     pts = dv.orbit_points(pmap, np.arange(k.size), first, k)
     return dv.distance_to_orbit(second, pts, turn_axis=2)[0] <= SAME_ORBIT_TOL

@@ -189,25 +189,6 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
     return LimitVerdicts(pd.concat([p[0] for p in parts], ignore_index=True), _concat_runs([p[1] for p in parts]))
 
 
-def _section_orbits(pmap: _SwitchedMap, states: np.ndarray, o: dict):
-    """The attracting orbits that runs reach (:func:`lib.dynamics.verdicts.find_orbits`) on their
-    section after the transient: ``states`` (N, transient + periods + 1, 6) at t = j T, the
-    options ``o`` (:data:`LIMIT_DEFAULTS`). Returns (the dict of ``find_orbits``, its turns n
-    counted against the path's heading; the step of Newton; the section history (L, N, 6), the
-    heading modulo 2 pi)."""
-    ntr, kmax = o["transient"], o["max_period"]
-    step = lambda i, x, k: pmap.step(i, x, k, o["fd_step"])  # noqa: E731
-    hist = np.moveaxis(states[:, ntr:], 0, 1).copy()
-    hist[..., 2] = np.mod(hist[..., 2], 2 * np.pi)     # the map commutes with whole turns of phi
-    orb = dv.find_orbits(step, pmap, np.arange(states.shape[0]), hist, max_period=kmax,
-                         candidate_tol=o["candidate_tol"], newton_tol=o["newton_tol"], reach_tol=o["approach_tol"],
-                         reach_floor=o["reach_tol"], newton_options=_NEWTON, fixed_turns=False, ends=2 * kmax)
-    # the turns against the path's heading: on the circle (27) phi_d itself turns once a period,
-    # so an orbit that follows it gains k turns per k periods and still holds the heading
-    orb["n"] = np.where(orb["found"], orb["n"] - orb["k"] * heading_turns(pmap.ref), orb["n"])
-    return orb, step, hist
-
-
 def _limit_chunk(b, f, S0, *, body, gains, ref, o, steps_per_period, locator, measure=True):
     """(frame, runs) of :func:`limit_verdicts` for validated pairs (one chunk of them)."""
     ntr, npr, blk, kmax = o["transient"], o["periods"], o["block"], o["max_period"]
@@ -215,9 +196,18 @@ def _limit_chunk(b, f, S0, *, body, gains, ref, o, steps_per_period, locator, me
                          lyapunov_from=ntr, steps_per_period=steps_per_period, locator=locator)
     T, N = runs.period, runs.states.shape[0]
     pmap = _SwitchedMap(body, gains, ref, runs.angle_limit, runs.force_limit, steps_per_period, locator)
+    step = lambda i, x, k: pmap.step(i, x, k, o["fd_step"])  # noqa: E731
     lamT, seT = dv.block_statistics(runs.log_growth, blk)
-    orb, step, hist = _section_orbits(pmap, runs.states, o)
+    hist = np.moveaxis(runs.states[:, ntr:], 0, 1).copy()
+    hist[..., 2] = np.mod(hist[..., 2], 2 * np.pi)     # the map commutes with whole turns of phi
+    idx = np.arange(N)
+    orb = dv.find_orbits(step, pmap, idx, hist, max_period=kmax, candidate_tol=o["candidate_tol"],
+                         newton_tol=o["newton_tol"], reach_tol=o["approach_tol"], reach_floor=o["reach_tol"],
+                         newton_options=_NEWTON, fixed_turns=False, ends=2 * kmax)
     found = orb["found"]
+    # the turns against the path's heading: on the circle (27) phi_d itself turns once a period,
+    # so an orbit that follows it gains k turns per k periods and still holds the heading
+    orb["n"] = np.where(found, orb["n"] - orb["k"] * heading_turns(ref), orb["n"])
     sec = runs.errors[:, ntr:]
     returns = dv.section_returns(np.moveaxis(sec, 0, 1), angles=(4,))
     regime, reason = dv.classify(lamT, seT, returns, band=o["lyapunov_band"], return_tol=o["return_tol"],
