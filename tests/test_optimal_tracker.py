@@ -16,6 +16,7 @@ from scipy.linalg import expm, solve_continuous_are
 
 from lib.allocation import Limits
 from lib.integrators.smooth import SimulationError
+from lib.angles import wrap_angle
 from lib.model import config_accel, generalized_force
 from lib.optimal import tracker
 from lib.optimal.tracker import RICCATI_SETTLE, RTOL, jacobians, periodic_lqr, track_motion
@@ -360,3 +361,61 @@ def test_the_compiled_riccati_rhs_is_the_numpy_one_on_a_collocated_motion(body):
         # accuracy: as above (with LAPACK's 2 x 2 solve for the gain): measured equal bit for bit here
         np.testing.assert_allclose(loop(t, Y.ravel(), t_in), want, rtol=1e-12, atol=1e-11)
     assert closed_loop_rhs(tracker.periodic_lqr(body, _CircleMotion(body))) is None
+
+
+
+def _random_collocated_lqr(body, seed):
+    """A collocated motion with random polynomials and inputs, and an LQR with a random grid of P
+    (the rates need no solution)."""
+    from lib.optimal.motion import PeriodicMotion
+    rng = np.random.default_rng(seed)
+    nodes, degree, T = 8, 3, 5.0
+    motion = PeriodicMotion(t=np.arange(nodes) * T / nodes, z=np.zeros((nodes, 3)), dz=np.zeros((nodes, 3)),
+                            F=rng.uniform(0.5, 3, nodes), beta=rng.uniform(-1, 1, nodes), max_error=0.0,
+                            rms_error=0.0, period=T, kind="circle", R=2.0, Theta=2 * np.pi / T, F_max=None,
+                            beta_max=None, nodes=nodes, degree=degree, turns=1, starts=(),
+                            collocation=rng.normal(size=(nodes, degree + 1, 6)))
+    grid = np.union1d(np.linspace(0, T, 33), motion.t)
+    P = rng.normal(size=(grid.size, 6, 6))
+    return tracker.PeriodicLQR(body, motion, tracker.DEFAULT_Q, tracker.DEFAULT_R, grid, P + np.swapaxes(P, 1, 2),
+                               rng.normal(size=(grid.size - 1, 2, 6, 6)), 1, 0.0, np.zeros(6))
+
+
+@pytest.mark.parametrize("F_max, beta_max", [(math.inf, None), (2.5, None), (math.inf, 0.5), (2.0, 0.3)])
+def test_the_compiled_loop_is_the_numpy_one_on_a_collocated_motion(body, F_max, beta_max, monkeypatch):
+    """lib.optimal.riccati.loop_rhs against the numpy rates of the clipped closed loop it compiles
+    (tracker._loop with the compiled path switched off), rows of states far from the motion, at
+    times inside, on and beyond the nodes, with and without each limit; the demands met include
+    negative forces (flipped without an angle limit), forces above the cap and angles beyond
+    the limit, so every branch of the clip is compared."""
+    lqr = _random_collocated_lqr(body, 11)
+    T, nodes = lqr.motion.period, lqr.motion.nodes
+    fast = tracker._loop(lqr, F_max, beta_max, 5)
+    monkeypatch.setattr(tracker, "loop_rhs", lambda *args: None)           # the numpy rates
+    slow = tracker._loop(lqr, F_max, beta_max, 5)
+    rng = np.random.default_rng(12)
+    demands = []
+    for t in np.r_[rng.uniform(-7, 13, 30), lqr.t[1:-1], lqr.t[1:-1] + 2 * T]:
+        lo = T / nodes * np.floor(t * nodes / T)
+        hi = lo + T / nodes
+        X = rng.normal(scale=2.0, size=(5, 6))
+        want = slow(lo, hi)(t, X.ravel())
+        # accuracy: the same formulas in their order, compiled, except u* - K (x - x*), summed in
+        # order where numpy's einsum may pair its terms: rounding of terms up to 1e3 N, through a
+        # clip that is continuous (a kink, not a jump), then cos and sin of the force's angle
+        np.testing.assert_allclose(fast(lo, hi)(t, X.ravel()), want, rtol=1e-11, atol=1e-10)
+        xs, us, K = tracker._loop_reference(lqr, t, tracker._inside(t, lo, hi))
+        demands.append(us - np.einsum("ij,rj->ri", K, X - xs))
+    U = np.concatenate(demands)
+    beta = np.where(U[:, 0] < 0, U[:, 1] + np.pi, U[:, 1])
+    assert (U[:, 0] < 0).sum() > 10 and (np.abs(U[:, 0]) > 2.5).sum() > 10
+    assert (np.abs(wrap_angle(beta)) > 0.5).sum() > 10
+
+
+def test_the_compiled_loop_raises_on_a_non_finite_rate(body):
+    """A state that makes the rates non-finite is refused, naming the time."""
+    lqr = _random_collocated_lqr(body, 13)
+    X = np.zeros((2, 6))
+    X[1, 0] = np.nan
+    with pytest.raises(SimulationError, match="non-finite at t = 0.3"):
+        tracker._loop(lqr, 2.0, 0.5, 2)(0.0, 0.625)(0.3, X.ravel())

@@ -1,7 +1,8 @@
 """The right-hand sides of :func:`lib.optimal.tracker.periodic_lqr` compiled, for a motion of
 :func:`lib.optimal.motion.periodic_motion` (its collocation polynomials and piecewise-constant
 inputs): the periodic Riccati equation's (:func:`riccati_rhs`) and the linearised closed loop's,
-whose monodromy matrix gives the multipliers (:func:`closed_loop_rhs`).
+whose monodromy matrix gives the multipliers (:func:`closed_loop_rhs`); and the clipped closed
+loop of :func:`lib.optimal.tracker.track_motion` itself (:func:`loop_rhs`).
 
 ``solve_ivp`` calls them on one matrix at a time, about 12 000 times a Riccati solution, so the
 numpy versions' cost was their calls' overhead: the motion's state read from its polynomials
@@ -25,7 +26,7 @@ from ..params import Body
 from .collocation import tableau
 from .motion import NODE_SNAP
 
-__all__ = ["riccati_rhs", "closed_loop_rhs"]
+__all__ = ["riccati_rhs", "closed_loop_rhs", "loop_rhs"]
 
 
 
@@ -39,9 +40,9 @@ def _locate(t, period, nodes, snap):  # pragma: no cover (compiled)
 
 
 @numba.njit(cache=True)
-def _jac(t, t_in, period, nodes, snap, turns, F, beta, basis, colloc, body):  # pragma: no cover (compiled)
-    """A (6, 6) and B (6, 2) of (2)-(4) about the motion's state at t and its inputs at t_in, as
-    ``lib.optimal.tracker._reference`` and ``_jacobians`` compute them."""
+def _state(t, t_in, period, nodes, snap, turns, F, beta, basis, colloc):  # pragma: no cover (compiled)
+    """The motion's state x* (6,) at t and its inputs (F*, beta*) at t_in, as
+    ``lib.optimal.tracker._reference`` computes them."""
     k, s, laps = _locate(t, period, nodes, snap)
     d1 = basis.shape[0]
     x = np.zeros(6)
@@ -54,7 +55,14 @@ def _jac(t, t_in, period, nodes, snap, turns, F, beta, basis, colloc, body):  # 
     x[2] += 2 * np.pi * turns * laps
     ti = t_in - math.floor(t_in / period) * period
     ki = _locate(ti, period, nodes, snap)[0]
-    f, b = F[ki], beta[ki]
+    return x, F[ki], beta[ki]
+
+
+@numba.njit(cache=True)
+def _jac(t, t_in, period, nodes, snap, turns, F, beta, basis, colloc, body):  # pragma: no cover (compiled)
+    """A (6, 6) and B (6, 2) of (2)-(4) about the motion's state at t and its inputs at t_in, as
+    ``lib.optimal.tracker._reference`` and ``_jacobians`` compute them."""
+    x, f, b = _state(t, t_in, period, nodes, snap, turns, F, beta, basis, colloc)
     m, I, a, c, cphi = body[0], body[1], body[2], body[3], body[4]
     co, si = math.cos(x[2] + b), math.sin(x[2] + b)
     ia = a / I
@@ -87,6 +95,17 @@ def _closed_rhs(t, t_in, y, period, nodes, snap, turns, F, beta, basis, colloc, 
     """(A - B K) Y at t for Y = y (36,) into out (36,), K = R^-1 B' P(t) with P(t) the cubic Hermite
     interpolant of the grid's P, dP (``PeriodicLQR.riccati``, ``PeriodicLQR._gain``)."""
     A, B = _jac(t, t_in, period, nodes, snap, turns, F, beta, basis, colloc, body)
+    K = _gain(t, period, B, R, grid, PG, dPG)
+    M = (A - B @ K) @ y.reshape(6, 6)
+    for i in range(6):
+        for j in range(6):
+            out[6 * i + j] = M[i, j]
+
+
+@numba.njit(cache=True)
+def _gain(t, period, B, R, grid, PG, dPG):  # pragma: no cover (compiled)
+    """K = R^-1 B' P(t) (2, 6), P(t) the cubic Hermite interpolant of the grid's P and dP
+    (``PeriodicLQR.riccati``, ``PeriodicLQR._gain``)."""
     s = np.mod(t, period)
     n = grid.size
     k = min(max(np.searchsorted(grid, s, side="right") - 1, 0), n - 2)
@@ -94,11 +113,88 @@ def _closed_rhs(t, t_in, y, period, nodes, snap, turns, F, beta, basis, colloc, 
     r = (s - grid[k]) / h
     P = ((1 + 2 * r) * (1 - r) ** 2 * PG[k] + r * (1 - r) ** 2 * h * dPG[k, 0]
          + r * r * (3 - 2 * r) * PG[k + 1] - r * r * (1 - r) * h * dPG[k, 1])
-    K = np.linalg.solve(R, np.ascontiguousarray(B.T) @ P)
-    M = (A - B @ K) @ y.reshape(6, 6)
-    for i in range(6):
+    return np.linalg.solve(R, np.ascontiguousarray(B.T) @ P)
+
+
+@numba.njit(cache=True)
+def _wrap(angle):  # pragma: no cover (compiled)
+    """:func:`lib.angles.wrap_angle` of one angle: pi - (pi - angle) mod 2 pi (numba's np.mod,
+    numpy's floored remainder), -pi returned as pi."""
+    w = np.pi - np.mod(np.pi - angle, 2 * np.pi)
+    return np.pi if w == -np.pi else w
+
+
+@numba.njit(cache=True)
+def _loop_rows(t, t_in, X, period, nodes, snap, turns, F, beta, basis, colloc, body, R, grid, PG, dPG,
+               F_max, beta_max, out):  # pragma: no cover (compiled)
+    """The clipped closed loop's rates (M, 6) into out for the states X (M, 6) at t, the motion's
+    inputs read at t_in, as ``lib.optimal.tracker._loop`` computes them: u = u* - K (x - x*), the
+    limits of ``_saturate`` (beta_max < 0: no angle limit), then (2)-(4)."""
+    xs, fs, bs = _state(t, t_in, period, nodes, snap, turns, F, beta, basis, colloc)
+    A, B = _jac(t, t_in, period, nodes, snap, turns, F, beta, basis, colloc, body)
+    K = _gain(t, period, B, R, grid, PG, dPG)
+    m, I, a, c, cphi = body[0], body[1], body[2], body[3], body[4]
+    for r in range(X.shape[0]):
+        u0, u1 = 0.0, 0.0
         for j in range(6):
-            out[6 * i + j] = M[i, j]
+            e = X[r, j] - xs[j]
+            u0 += K[0, j] * e
+            u1 += K[1, j] * e
+        f, b = fs - u0, bs - u1
+        if math.isnan(f) or math.isnan(b):
+            for j in range(6):
+                out[r, j] = math.nan
+            continue
+        if beta_max < 0.0:
+            if f < 0.0:
+                b = b + np.pi
+            f = abs(f)
+        f = min(max(f, 0.0), F_max)
+        b = _wrap(b)
+        if beta_max >= 0.0:
+            b = min(max(b, -beta_max), beta_max)
+        phi = X[r, 2]
+        out[r, 0], out[r, 1], out[r, 2] = X[r, 3], X[r, 4], X[r, 5]
+        out[r, 3] = (f * math.cos(phi + b) - c * X[r, 3]) / m
+        out[r, 4] = (f * math.sin(phi + b) - c * X[r, 4]) / m
+        out[r, 5] = (f * math.sin(b) * a - cphi * X[r, 5]) / I
+
+
+def loop_rhs(lqr, F_max: float, beta_max: float | None):
+    """The compiled rates of the clipped closed loop of :func:`lib.optimal.tracker.track_motion`
+    (u = u*(t) - K(t) (x - x*(t)), clipped to ``F_max`` (N, inf for none) and ``beta_max`` (rad,
+    None for none), then (2)-(4)), or None for a motion without collocation polynomials (the
+    tracker keeps its numpy rates).
+
+    Parameters
+    ----------
+    lqr : PeriodicLQR
+        The periodic LQR.
+    F_max : float
+        Force limit (N), inf for none.
+    beta_max : float or None
+        Angle limit (rad), None for none.
+
+    Returns
+    -------
+    callable or None
+        ``rhs(t, X, t_in)``: the rates (M, 6) of the states X (M, 6) (m, m, rad, m/s, m/s, rad/s)
+        at t (s), the inputs read at ``t_in`` (s).
+    """
+    motion, body = lqr.motion, lqr.body
+    if not all(hasattr(motion, a) for a in ("collocation", "nodes", "degree", "F", "beta")):
+        return None
+    args = _motion_arrays(body, motion)
+    R, grid = np.ascontiguousarray(lqr.R, dtype=float), np.ascontiguousarray(lqr.t, dtype=float)
+    PG, dPG = np.ascontiguousarray(lqr.P, dtype=float), np.ascontiguousarray(lqr.dP, dtype=float)
+    fmax, bmax = float(F_max), (-1.0 if beta_max is None else float(beta_max))
+
+    def rhs(t, X, t_in):
+        X = np.ascontiguousarray(X, dtype=float)
+        out = np.empty_like(X)
+        _loop_rows(float(t), float(t_in), X, *args, R, grid, PG, dPG, fmax, bmax, out)
+        return out
+    return rhs
 
 
 def riccati_rhs(body: Body, motion, Q: np.ndarray, R_inv: np.ndarray):

@@ -29,7 +29,7 @@ from ..model import config_accel, generalized_force
 from ..params import PAPER_DZ0, PAPER_Z0, Body
 from ..simulate import DEFAULT_RATE, SimulationResult
 from ..trajectories import make
-from .riccati import closed_loop_rhs, riccati_rhs
+from .riccati import closed_loop_rhs, loop_rhs, riccati_rhs
 
 __all__ = ["PeriodicLQR", "jacobians", "periodic_lqr", "track_motion",
            "DEFAULT_Q", "DEFAULT_R", "RTOL", "NEWTON_TOL", "NEWTON_ITER", "NEWTON_STALL", "REACH_TOL",
@@ -352,8 +352,21 @@ def _loop_reference(lqr: PeriodicLQR, t, t_in=None):
 def _loop(lqr: PeriodicLQR, F_max, beta_max, rows: int, memo: dict | None = None):
     """The closed loop's rates on an input piece [lo, hi], ``rows`` states in one flat vector.
     ``memo``, for fixed steps that meet the same times again: (t, lo, hi) -> (x*, u*, K), which
-    depend on the time alone."""
+    depend on the time alone. Compiled (:func:`lib.optimal.riccati.loop_rhs`) for a motion with
+    collocation polynomials; the memo is then not needed."""
+    fast = loop_rhs(lqr, F_max, beta_max)
+
     def piece(lo, hi):
+        if fast is not None:
+            a_in, b_in = lo + 1e-6 * (hi - lo), hi - 1e-6 * (hi - lo)      # _inside, for one time
+
+            def compiled(t, s):
+                out = fast(t, s.reshape(rows, 6), min(max(t, a_in), b_in)).ravel()
+                if not np.all(np.isfinite(out)):
+                    raise SimulationError(f"closed loop became non-finite at t = {t:.6g} s")
+                return out
+            return compiled
+
         def rhs(t, s):
             X = s.reshape(rows, 6)
             ref = None if memo is None else memo.get((t, lo, hi))
