@@ -5,6 +5,7 @@ import pytest
 from hypothesis import given, settings, strategies as st_
 
 from flows import damped_oscillator_flow, driven_pendulum_flow
+from lib.dynamics import verdicts as dv
 from lib.limits import verdicts as L
 from lib import trajectories as T
 from lib.params import Body, Gains
@@ -412,3 +413,52 @@ def test_range_and_position_error_are_over_the_whole_orbit_not_its_section(deg, 
     assert np.ptp(p) > 3.0                                        # about +-2 rad: far from the section's 0
     assert row.p_range == pytest.approx(np.ptp(p), abs=5e-3)  # measured 8.8e-4: the range read from 2001 samples
     assert row.pos_err == pytest.approx(np.hypot(e[:, 0], e[:, 1]).max(), abs=3e-6)  # measured 2.6e-7
+
+
+def test_switched_runs_record_the_run_itself_within_its_periods():
+    """``record`` = (k, S) keeps the run's own states S times a period from period k on: the run,
+    its companion and its statistics are the ones without it, bit for bit, and the recorded
+    states at the period ends are its sections, bit for bit."""
+    ref = T.eight()
+    args = (Body(), Gains(), ref, np.radians([30.0, 90.0]), [np.inf, 4.0])
+    plain = L.switched_runs(*args, n_periods=6, lyapunov_from=2)
+    rec = L.switched_runs(*args, n_periods=6, lyapunov_from=2, record=(2, 8))
+    # exact: recording only copies states at step ends, the arithmetic of the run is unchanged
+    assert np.array_equal(rec.states, plain.states) and np.array_equal(rec.log_growth, plain.log_growth)
+    assert np.array_equal(rec.locating, plain.locating) and plain.recorded is None
+    assert rec.recorded.shape == (2, 4 * 8 + 1, 6)
+    assert np.array_equal(rec.recorded[:, ::8], rec.states[:, 2:])          # exact: the same states
+    # accuracy: (k S) (T / S) against k T, a rounding or two of each (measured 0)
+    np.testing.assert_allclose(rec.recorded_t[::8], rec.t[2:], rtol=1e-12)
+    # within the period: the same states as a run sampled S times a period from period 2's start
+    # (its kernel steps from other times, so the 30-degree run, which switches, may differ by the
+    # bracketing of its events)
+    again = L.switched_runs(*args, s0=rec.states[:, 2], n_periods=4, samples_per_period=8)
+    # accuracy: events bracketed to 1e-11 s x rates below 10, over four periods (measured 1e-14)
+    np.testing.assert_allclose(rec.recorded, again.states, rtol=0, atol=1e-9)
+    with pytest.raises(ValueError, match="record"):
+        L.switched_runs(*args, n_periods=6, record=(6, 8))
+    with pytest.raises(ValueError, match="record"):
+        L.switched_runs(*args, n_periods=6, record=(0, 3))
+    with pytest.raises(ValueError, match="record"):
+        L.switched_runs(*args, n_periods=6, samples_per_period=2, record=(0, 2))
+
+
+def test_a_chaotic_rows_measures_are_taken_on_the_run_it_was_decided_on():
+    """Without an orbit, the heading's drift and range come from the decided run's own states:
+    its block-end headings are the run's sections (recomputed here from ``runs.states``), and
+    its range of p covers every section's p."""
+    body, gains, ref = Body(), Gains(), T.eight(R=2.0, theta=math.pi / 4)
+    o = dict(transient=10, periods=48, block=12)
+    fr, runs = L.limit_verdicts(body, gains, ref, [math.radians(30.0)], None, **o)
+    row = fr.iloc[0]
+    assert row.period == 0 and runs.recorded is None                 # not kept with the runs
+    sec = runs.states[0, o["transient"]:]
+    p = sec[:, 2] - ref.z(runs.t[o["transient"]:])[:, 2]
+    ends = p[::o["block"]]
+    drift, se = dv.drift_statistics(ends[None], o["block"], 2 * np.pi)
+    # accuracy: the same headings; phi_d at k T / S x S against k T, rounding of 1e2 rad
+    assert row.drift == pytest.approx(drift[0], rel=0, abs=1e-12)
+    assert row.drift_stderr == pytest.approx(se[0], rel=0, abs=1e-12)  # accuracy: as the drift's
+    # accuracy: the samples include the sections bit for bit; phi_d read at (k S) (T / S), 1e-9
+    assert row.p_range >= np.ptp(p) - 1e-9

@@ -115,6 +115,9 @@ def test_limit_verdicts_through_a_process_pool_are_the_single_call(pool):
     pd.testing.assert_frame_equal(got, whole, check_exact=True)      # including the located orbits
     for name in L.SwitchedRuns.__dataclass_fields__:
         a, b = getattr(got_runs, name), getattr(runs, name)
+        if a is None or b is None:                                     # the samples are not kept
+            assert a is None and b is None, name
+            continue
         assert np.array_equal(a, b, equal_nan=True), name
     with pytest.raises(ValueError, match="angle_limits"):                # checked here, before any chunk leaves
         L.limit_verdicts(Body(), Gains(), ref, [0.5, 4.0], executor=pool, **o)

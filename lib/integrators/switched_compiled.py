@@ -81,10 +81,12 @@ def _new_mode(P, lim, mode, t, s, g0, g2, stats):
 
 @numba.njit
 def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2, yh, fh, gh, dense, AX, CX, D,
-             F, stats):
+             F, stats, rec, r0, every):
     """Integrate s (in place) over n_steps steps of size h from t0; returns the final mode.
     stats: [crossings, slides, time sliding, events, failed, steps locating events, dense
-    estimates rejected]; ``dense``: the locator (:mod:`lib.integrators.switched_events`)."""
+    estimates rejected]; ``dense``: the locator (:mod:`lib.integrators.switched_events`).
+    With ``every`` > 0 the state at the end of every ``every``-th step goes to row
+    r0 + (j + 1) / every of ``rec`` (the run itself is not changed)."""
     # K[0] holds the rates at (t, s) under the mode at every step's start (see _step): from the
     # field evaluated here or after an event, or from the end of the step before when that
     # step ended at the same time to the bit (t + dt == t_end), else evaluated again
@@ -130,6 +132,9 @@ def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2
             if not math.isfinite(s[q]):
                 stats[4] = 2.0
                 return mode
+        if every > 0 and (j + 1) % every == 0:
+            for q in range(6):
+                rec[r0 + (j + 1) // every, q] = s[q]
     return mode
 
 
@@ -149,7 +154,7 @@ def _make_run(stamp: int):
 
     @numba.njit(cache=True, parallel=True)
     def _run(P, bmax, fmax, S0, n_periods, n_steps, T, t0, lyap_from, d0, A, b, c, dense, AX, CX, D, sections,
-             modes, logs, stats):
+             modes, logs, stats, rec_from, rec_every, samples):
         if stamp < 0:
             return
         N = S0.shape[0]
@@ -168,19 +173,24 @@ def _make_run(stamp: int):
             mode2 = 1
             for q6 in range(6):
                 sections[q, 0, q6] = s[q6]
+            per = n_steps // rec_every if rec_every > 0 else 0       # samples a period
             for k in range(n_periods):
                 ta = t0 + k * T
+                every = rec_every if 0 <= rec_from <= k else 0
+                if every > 0 and k == rec_from:
+                    for q6 in range(6):
+                        samples[q, 0, q6] = s[q6]
                 if k == lyap_from:
                     for q6 in range(6):
                         s2[q6] = s[q6] + d0 / math.sqrt(6.0)
                     mode2 = _initial_mode(P, lim, ta, s2, g0, ys)
                 mode = _advance(P, lim, mode, ta, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2, yh, fh, gh, dense,
-                                AX, CX, D, F, stats[q])
+                                AX, CX, D, F, stats[q], samples[q], (k - rec_from) * per, every)
                 if stats[q, 4] != 0.0:
                     break
                 if k >= lyap_from >= 0:
                     mode2 = _advance(P, lim, mode2, ta, s2, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1,
-                                     g2, yh, fh, gh, dense, AX, CX, D, F, st2)
+                                     g2, yh, fh, gh, dense, AX, CX, D, F, st2, samples[q], 0, 0)
                     if st2[4] != 0.0:
                         stats[q, 4] = st2[4]
                         break
@@ -205,14 +215,16 @@ _run = _make_run(_sources_stamp())
 
 def run_periods(P: np.ndarray, angle_limits: np.ndarray, force_limits: np.ndarray, S0: np.ndarray, n_periods: int,
                 steps_per_period: int, period: float, t0: float, lyapunov_from: int, d0: float, A: np.ndarray,
-                b: np.ndarray, c: np.ndarray, *, dense_output: tuple | None = None):
+                b: np.ndarray, c: np.ndarray, *, dense_output: tuple | None = None, record: tuple | None = None):
     """Low-level entry (see :func:`lib.limits.runs.switched_runs` for the checked one): N runs
     of ``n_periods`` periods from states S0 (N, 6) at t0. Returns the states at the period
     ends (N, n_periods + 1, 6), the final modes (N,), log(d/d0) of the companion per
     period from ``lyapunov_from`` on (N, n_periods - lyapunov_from; -1 for none) and the
     statistics (N, 7): crossings, slides, time sliding (s), events, failure flag
     (1: an accumulation of events, 2: a non-finite state), real steps spent locating events,
-    dense estimates rejected (:mod:`lib.integrators.switched_events`).
+    dense estimates rejected (:mod:`lib.integrators.switched_events`). With ``record`` = (k, S)
+    also the states S times a period (at the ends of every ``steps_per_period / S``-th step of
+    the same run) from the start of period k on (N, (n_periods - k) S + 1, 6), else None.
 
     Parameters
     ----------
@@ -235,11 +247,15 @@ def run_periods(P: np.ndarray, angle_limits: np.ndarray, force_limits: np.ndarra
     dense_output : tuple, optional
         (A_extra (3, 16), C_extra (3,), D (4, 16)) of DOP853's dense output
         (:func:`dop853_dense`): events are located on it first; None, by real steps only.
+    record : tuple, optional
+        (first period k, samples per period S), S dividing ``steps_per_period``: the run's
+        states S times a period from period k on.
 
     Returns
     -------
     tuple
-        States (N, n_periods + 1, 6), final modes (N,), log-growths and statistics (N, 7).
+        States (N, n_periods + 1, 6), final modes (N,), log-growths, statistics (N, 7) and the
+        recorded states (or None).
     """
     N = S0.shape[0]
     sections = np.full((N, n_periods + 1, 6), np.nan)
@@ -247,6 +263,14 @@ def run_periods(P: np.ndarray, angle_limits: np.ndarray, force_limits: np.ndarra
     n_log = n_periods - lyapunov_from if lyapunov_from >= 0 else 0
     logs = np.full((N, max(n_log, 0)), np.nan)
     stats = np.zeros((N, 7))
+    if record is None:
+        rec_from, rec_every, samples = -1, 0, np.zeros((N, 1, 6))
+    else:
+        rec_from, per = (int(v) for v in record)
+        if not (0 <= rec_from < n_periods and per >= 1 and steps_per_period % per == 0):
+            raise ValueError(f"record must be (k, S), 0 <= k < n_periods ({n_periods}), S dividing "
+                             f"steps_per_period ({steps_per_period}), got {record!r}")
+        rec_every, samples = steps_per_period // per, np.full((N, (n_periods - rec_from) * per + 1, 6), np.nan)
     if dense_output is None:
         AX, CX, D = np.zeros((3, 16)), np.zeros(3), np.zeros((4, 16))
     else:
@@ -257,8 +281,8 @@ def run_periods(P: np.ndarray, angle_limits: np.ndarray, force_limits: np.ndarra
          np.ascontiguousarray(force_limits, float), np.ascontiguousarray(S0, float), int(n_periods),
          int(steps_per_period), float(period), float(t0), int(lyapunov_from), float(d0),
          np.ascontiguousarray(A, float), np.ascontiguousarray(b, float), np.ascontiguousarray(c, float),
-         dense_output is not None, AX, CX, D, sections, modes, logs, stats)
-    return sections, modes, logs, stats
+         dense_output is not None, AX, CX, D, sections, modes, logs, stats, rec_from, rec_every, samples)
+    return sections, modes, logs, stats, (None if record is None else samples)
 
 
 def dop853_dense() -> tuple:

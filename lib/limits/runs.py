@@ -55,7 +55,9 @@ class SwitchedRuns:
     the final modes, ``log_growth`` (N, n_lyap) the companion's log(d / d0) over each
     period from ``lyapunov_from`` on, and the crossings of S, slides and time sliding (s)
     of each run; ``locating`` (N, 3): its events, the real steps spent locating them and the
-    dense estimates handed on to the bracket locator (:mod:`lib.integrators.switched_events`)."""
+    dense estimates handed on to the bracket locator (:mod:`lib.integrators.switched_events`);
+    with ``record`` given to :func:`switched_runs`, ``recorded`` (N, m, 6) the same runs' states
+    at the times ``recorded_t`` (m,), s (else both None)."""
 
     angle_limit: np.ndarray
     force_limit: np.ndarray
@@ -70,6 +72,8 @@ class SwitchedRuns:
     slides: np.ndarray
     t_sliding: np.ndarray
     locating: np.ndarray
+    recorded: np.ndarray | None = None
+    recorded_t: np.ndarray | None = None
 
 
 #: steps of the compiled integrator per reference period (8th-order Dormand-Prince)
@@ -120,7 +124,9 @@ def _concat_runs(parts: list) -> SwitchedRuns:
     """The :class:`SwitchedRuns` of consecutive chunks of runs as one (the runs in order)."""
     if len(parts) == 1:
         return parts[0]
-    shared = ("period", "t", "lyapunov_from")
+    shared = ("period", "t", "lyapunov_from", "recorded_t")
+    if parts[0].recorded is None:
+        shared += ("recorded",)
     return SwitchedRuns(**{name: getattr(parts[0], name) if name in shared else
                            np.concatenate([getattr(r, name) for r in parts])
                            for name in SwitchedRuns.__dataclass_fields__})
@@ -129,7 +135,7 @@ def _concat_runs(parts: list) -> SwitchedRuns:
 def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_limits=None, *, s0=None,
                   n_periods: int, lyapunov_from: int | None = None, steps_per_period: int = STEPS_PER_PERIOD,
                   samples_per_period: int = 1, d0: float = 1e-7, k_slide: float = 5.0,
-                  locator: str = "dense") -> SwitchedRuns:
+                  locator: str = "dense", record: tuple[int, int] | None = None) -> SwitchedRuns:
     """Run the closed loop (2)-(4), (23), (25)-(26) with |beta| <= ``angle_limits`` (rad;
     pi for no angle limit) and F <= ``force_limits`` (N; None or inf for no cap), one run
     per pair, for ``n_periods`` reference periods from the states ``s0`` ((6,) or (N, 6);
@@ -138,7 +144,10 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
     times per period (it must divide ``steps_per_period``). With ``lyapunov_from`` = k
     (only with one sample per period) a companion run starts d0 (m, rad, m/s, rad/s: the
     plain Euclidean distance of states) away at the end of period k and is renormalised
-    every period (Benettin).
+    every period (Benettin). With ``record`` = (k, S') the same runs' states are also kept
+    S' times a period from the start of period k on (``recorded``; S' divides
+    ``steps_per_period``; only with one sample per period): the states of the run itself,
+    read at the ends of its steps, the run unchanged.
 
     ``ref`` must be the circle or the eight (:mod:`lib.trajectories`). Raises
     ``RuntimeError`` naming the run if its state becomes non-finite or the switching
@@ -173,6 +182,8 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
     locator : {"dense", "bracket"}
         How events are located (:data:`LOCATORS`): on the step's 7th-order dense output,
         then one real step, or by real steps only; both to 1e-11 s.
+    record : tuple of int, optional
+        (first period k, samples per period S'), 0 <= k < ``n_periods``.
 
     Returns
     -------
@@ -193,6 +204,18 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
                          f"({steps_per_period}), got {S!r}")
     if S > 1 and lyapunov_from is not None:
         raise ValueError("the Lyapunov companion needs samples_per_period = 1")
+    if record is not None:
+        if S > 1:
+            raise ValueError("record needs samples_per_period = 1")
+        rec = tuple(record)
+        if len(rec) != 2:
+            raise ValueError(f"record must be (first period, samples per period), got {record!r}")
+        k_rec = checks.integer("record[0]", rec[0], minimum=0)
+        s_rec = checks.integer("record[1]", rec[1], minimum=1)
+        if k_rec >= n_periods or steps_per_period % s_rec:
+            raise ValueError(f"record must be (k, S) with k < n_periods ({n_periods}) and S dividing "
+                             f"steps_per_period ({steps_per_period}), got {record!r}")
+        record = (k_rec, s_rec)
     if not checks.number("d0", d0, positive=True) < 1e-3:
         raise ValueError(f"d0 must be in (0, 1e-3), got {d0!r}")
     locator = checks.one_of("locator", locator, LOCATORS)
@@ -206,9 +229,9 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
     T = ref.period
     # with S samples per period the kernel's "period" is T / S: the reference is T-periodic,
     # the kernel only needs the sampling interval and the steps within it
-    states, modes, logs, stats = run_periods(P, b, f, S0, int(n_periods) * S, int(steps_per_period) // S, T / S,
-                                             0.0, lf, float(d0), tab.A, tab.b / tab.b_den, tab.c,
-                                             dense_output=dop853_dense() if locator == "dense" else None)
+    states, modes, logs, stats, recorded = run_periods(
+        P, b, f, S0, int(n_periods) * S, int(steps_per_period) // S, T / S, 0.0, lf, float(d0), tab.A,
+        tab.b / tab.b_den, tab.c, dense_output=dop853_dense() if locator == "dense" else None, record=record)
     bad = np.flatnonzero(stats[:, 4] != 0)
     if bad.size:
         q = int(bad[0])
@@ -220,4 +243,6 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
     return SwitchedRuns(angle_limit=b, force_limit=f, period=T, t=t, states=states, errors=err, mode_end=modes,
                         log_growth=logs, lyapunov_from=lf, crossings=stats[:, 0].astype(int),
                         slides=stats[:, 1].astype(int), t_sliding=stats[:, 2],
-                        locating=stats[:, [3, 5, 6]].astype(int))
+                        locating=stats[:, [3, 5, 6]].astype(int), recorded=recorded,
+                        recorded_t=None if record is None else
+                        (record[0] * record[1] + np.arange(recorded.shape[1])) * (T / record[1]))

@@ -14,6 +14,7 @@ re-exported here, and :func:`limit_verdicts`, which Chapter 4 uses). The verdict
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import NamedTuple
 
 import numpy as np
@@ -150,8 +151,9 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
     locator : {"dense", "bracket"}
         How the compiled integrator locates events (:mod:`lib.integrators.switched_events`).
     measure : bool
-        Whether to take the measures over the whole orbit or run (a second run of each pair,
-        about a fifth of the cost). False, for a caller that reads only the verdicts: p_range,
+        Whether to take the measures over the whole orbit or run (the decided run's states kept
+        40 times a period after the transient, and a run over each located orbit). False, for a
+        caller that reads only the verdicts: p_range,
         pos_err, drift and drift_stderr are NaN without an orbit (an orbit's drift is still
         n / k), lost is NA without an orbit and turns_round NA everywhere (pandas' nullable
         booleans); the verdicts, periods, multipliers, exponents and orbits are the same.
@@ -192,8 +194,10 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
 def _limit_chunk(b, f, S0, *, body, gains, ref, o, steps_per_period, locator, measure=True):
     """(frame, runs) of :func:`limit_verdicts` for validated pairs (one chunk of them)."""
     ntr, npr, blk, kmax = o["transient"], o["periods"], o["block"], o["max_period"]
+    # with the measures, the run also keeps its states MEASURE_SAMPLES times a period after the transient
+    record = (ntr, MEASURE_SAMPLES) if measure and steps_per_period % MEASURE_SAMPLES == 0 else None
     runs = switched_runs(body, gains, ref, b, f, s0=S0, n_periods=ntr + npr,
-                         lyapunov_from=ntr, steps_per_period=steps_per_period, locator=locator)
+                         lyapunov_from=ntr, steps_per_period=steps_per_period, locator=locator, record=record)
     T, N = runs.period, runs.states.shape[0]
     pmap = _SwitchedMap(body, gains, ref, runs.angle_limit, runs.force_limit, steps_per_period, locator)
     step = lambda i, x, k: pmap.step(i, x, k, o["fd_step"])  # noqa: E731
@@ -225,7 +229,8 @@ def _limit_chunk(b, f, S0, *, body, gains, ref, o, steps_per_period, locator, me
     mu[found] = orb["rho"][found]
     regime[found] = dv.orbit_regime(orb["n"][found])
     reason[found] = ""
-    m = _over_the_run(pmap, runs.states[:, ntr], orb, npr, blk) if measure else _orbit_measures(orb)
+    m = _over_the_run(pmap, runs.states[:, ntr], orb, npr, blk, runs) if measure else _orbit_measures(orb)
+    runs = replace(runs, recorded=None, recorded_t=None)           # read: not kept with the runs
     lost = dv.heading_lost(found, orb["n"], m["drift"], m["drift_stderr"], slip_band=o["slip_band"])
     frame = pd.DataFrame(dict(
         angle_limit=runs.angle_limit, angle_deg=np.degrees(runs.angle_limit), force_limit=runs.force_limit,
@@ -255,14 +260,15 @@ def _orbit_measures(orb: dict) -> dict:
 MEASURE_SAMPLES = 40
 
 
-def _over_the_run(pmap: "_SwitchedMap", start, orb: dict, periods: int, block: int) -> dict:
+def _over_the_run(pmap: "_SwitchedMap", start, orb: dict, periods: int, block: int, runs=None) -> dict:
     """What the section alone cannot show, sampled ``MEASURE_SAMPLES`` times a period: the
     range of p (rad) and the largest position error (m) over the whole orbit (its k periods
     from the orbit's point) or, without one, over the observed run (``periods`` periods from
     ``start``, the state at the end of the transient); and the heading's drift (turns per
     period) with its batch-means standard error (blocks of ``block`` periods): n / k with no
-    error on an orbit. The runs without an orbit are integrated again from ``start`` on the
-    same step grid; for a chaotic one the samples are a second trajectory on the same attractor."""
+    error on an orbit. Without an orbit the samples are the decided run's own (``runs.recorded``,
+    kept by the run the verdict was read from), or, where it kept none, the run integrated again
+    from ``start`` on the same step grid (for a chaotic one a second trajectory on the attractor)."""
     N = start.shape[0]
     out = dict(p_range=np.full(N, np.nan), pos_err=np.full(N, np.nan), drift=np.full(N, np.nan),
                drift_stderr=np.full(N, np.nan))
@@ -270,17 +276,22 @@ def _over_the_run(pmap: "_SwitchedMap", start, orb: dict, periods: int, block: i
     groups += [(np.flatnonzero(orb["found"] & (orb["lag"] == k)), int(k), orb["x"])
                for k in np.unique(orb["lag"][orb["found"]])]
     S = MEASURE_SAMPLES
-    for rows, k, x0 in groups:
+    own = runs is not None and runs.recorded is not None
+    for j, (rows, k, x0) in enumerate(groups):
         if rows.size == 0:
             continue
-        r = switched_runs(pmap.body, pmap.gains, pmap.ref, pmap.b[rows], pmap.f[rows], s0=x0[rows], n_periods=k,
-                          steps_per_period=pmap.steps, samples_per_period=S, locator=pmap.locator)
-        p = r.states[:, :, 2] - pmap.ref.z(r.t)[:, 2][None]
-        err = r.errors
+        if j == 0 and own:                     # the run's own samples, from the transient's end on
+            t, states = runs.recorded_t, runs.recorded[rows]
+            err = error_state(pmap.ref, np.tile(t, rows.size), states.reshape(-1, 6)).reshape(states.shape)
+        else:
+            r = switched_runs(pmap.body, pmap.gains, pmap.ref, pmap.b[rows], pmap.f[rows], s0=x0[rows],
+                              n_periods=k, steps_per_period=pmap.steps, samples_per_period=S, locator=pmap.locator)
+            t, states, err = r.t, r.states, r.errors
+        p = states[:, :, 2] - pmap.ref.z(t)[:, 2][None]
         e = np.hypot(err[..., 0], err[..., 1])
         with np.errstate(invalid="ignore", divide="ignore"):
             de = np.where(e > 0, (err[..., 0] * err[..., 2] + err[..., 1] * err[..., 3]) / e, 0.0)
-        h = r.t[1] - r.t[0]
+        h = t[1] - t[0]
         out["p_range"][rows] = sampled_range(p, cyclic=False, dy=err[..., 5], h=h)     # Hermite-refined extremes
         out["pos_err"][rows] = sampled_extremes(e, cyclic=False, dy=de, h=h)[1]
         if k == periods and not orb["found"][rows[0]]:
