@@ -275,8 +275,10 @@ def _periodic_range(A, B, C, f, H, n: int, corrected: bool, n_starts: int = 16, 
     sampled at ``n_starts`` starts round the reference's heading H(0), the falling
     crossing nearest p = 0 bracketed and refined by the Illinois method to |g| <= tol, each
     point on its own (a located point is not integrated again).
-    The extremes of p over the orbit's steps are refined by parabolas (the range is then
-    good to about 2e-6 rad: unchanged to that with four times the steps)."""
+    The extremes of p over the orbit's steps are refined by parabolas. Against four times
+    the steps, on the book's slow band (Fig. 5's 1800 points with Theta <= 0.3 rad/s, 1024
+    steps), the overdamped range moves by 2.3e-6 rad at most and the corrected one by
+    6.0e-5 rad (above 1e-5 at 95 of them)."""
     N = A.size
     x = H[0] + 2 * np.pi * (np.arange(n_starts) / n_starts - 0.5)
     g = _period(np.broadcast_to(x, (N, n_starts)), A[:, None], B[:, None], C[:, None], f, n, corrected) - x
