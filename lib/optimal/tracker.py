@@ -150,7 +150,12 @@ def _piecewise_ivp(make_rhs, y0, edges, t_eval, atol: float, what: str):
 
 def _inside(t, lo: float, hi: float):
     """t moved 1e-6 of the piece [lo, hi] inside it: where the inputs of that piece are read."""
-    return np.clip(t, lo + 1e-6 * (hi - lo), hi - 1e-6 * (hi - lo))
+    return np.clip(t, *_inside_bounds(lo, hi))
+
+
+def _inside_bounds(lo: float, hi: float) -> tuple[float, float]:
+    """The bounds of :func:`_inside` (for one time t, ``min(max(t, a), b)`` is its value)."""
+    return lo + 1e-6 * (hi - lo), hi - 1e-6 * (hi - lo)
 
 
 def _jacobians(body: Body, x: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -288,7 +293,8 @@ def periodic_lqr(body: Body, motion, *, Q=None, R_weight=None, samples: int = 10
 
     def piece(lo, hi):
         if fast is not None:
-            return lambda t, p: fast(t, p, _inside(t, lo, hi))
+            a, b = _inside_bounds(lo, hi)
+            return lambda t, p: fast(t, p, min(max(t, a), b))
 
         def rhs(t, p):
             A, B = _jacobians(body, *_reference(motion, t, _inside(t, lo, hi)))
@@ -322,7 +328,8 @@ def _monodromy_multipliers(lqr: PeriodicLQR) -> np.ndarray:
 
     def piece(lo, hi):
         if fast is not None:
-            return lambda t, y: fast(t, y, _inside(t, lo, hi))
+            a, b = _inside_bounds(lo, hi)
+            return lambda t, y: fast(t, y, min(max(t, a), b))
 
         def rhs(t, y):
             x, u = _reference(lqr.motion, t, _inside(t, lo, hi))
@@ -358,7 +365,7 @@ def _loop(lqr: PeriodicLQR, F_max, beta_max, rows: int, memo: dict | None = None
 
     def piece(lo, hi):
         if fast is not None:
-            a_in, b_in = lo + 1e-6 * (hi - lo), hi - 1e-6 * (hi - lo)      # _inside, for one time
+            a_in, b_in = _inside_bounds(lo, hi)
 
             def compiled(t, s):
                 out = fast(t, s.reshape(rows, 6), min(max(t, a_in), b_in)).ravel()
