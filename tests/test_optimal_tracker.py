@@ -320,50 +320,6 @@ def test_default_starts_are_the_paper_start_and_its_shifts():
     np.testing.assert_allclose(np.abs(s[1:] - base).max(axis=1), [0.5, 0.5, 0.5, 0.5, np.pi / 2, np.pi / 2])
 
 
-def test_the_compiled_riccati_rhs_is_the_numpy_one_on_a_collocated_motion(body):
-    """lib.optimal.riccati against the numpy right-hand sides it compiles (the Riccati equation's,
-    the linearised closed loop's), on a motion with collocation polynomials and piecewise-constant
-    inputs and an LQR with a random grid of P (random: the rhs needs no solution), at times
-    inside, on and beyond the nodes, with heading turns."""
-    from lib.optimal.motion import PeriodicMotion
-    from lib.optimal.riccati import closed_loop_rhs, riccati_rhs
-    rng = np.random.default_rng(8)
-    nodes, degree, T = 8, 3, 5.0
-    motion = PeriodicMotion(t=np.arange(nodes) * T / nodes, z=np.zeros((nodes, 3)), dz=np.zeros((nodes, 3)),
-                            F=rng.uniform(0.5, 3, nodes), beta=rng.uniform(-1, 1, nodes), max_error=0.0,
-                            rms_error=0.0, period=T, kind="circle", R=2.0, Theta=2 * np.pi / T, F_max=None,
-                            beta_max=None, nodes=nodes, degree=degree, turns=1, starts=(),
-                            collocation=rng.normal(size=(nodes, degree + 1, 6)))
-    Q, R_inv = tracker.DEFAULT_Q, np.linalg.inv(tracker.DEFAULT_R)
-    fast = riccati_rhs(body, motion, Q, R_inv)
-    for t in np.r_[rng.uniform(-7, 13, 40), np.arange(-2, 18) * T / nodes]:
-        P = rng.normal(size=(6, 6))
-        P = P + P.T
-        t_in = T / nodes * (np.floor(t * nodes / T) + 0.5)           # inside t's input piece
-        A, B = tracker._jacobians(body, *tracker._reference(motion, t, t_in))
-        want = tracker._riccati_rate(A, B, P, R_inv, Q).ravel()
-        # accuracy: the same formulas in their order, compiled (the polynomial's sum over the basis
-        # written out where numpy's einsum may sum otherwise, numba's BLAS calls for the products):
-        # measured equal bit for bit over 420 times here; the bound allows rounding of terms up to 3e3
-        np.testing.assert_allclose(fast(t, P.ravel(), t_in), want, rtol=1e-12, atol=1e-11)
-    assert riccati_rhs(body, _CircleMotion(body), Q, R_inv) is None   # no polynomials: the numpy rhs
-    grid = np.union1d(np.linspace(0, T, 33), motion.t)
-    P = rng.normal(size=(grid.size, 6, 6))
-    lqr = tracker.PeriodicLQR(body, motion, Q, tracker.DEFAULT_R, grid, P + np.swapaxes(P, 1, 2),
-                              rng.normal(size=(grid.size - 1, 2, 6, 6)), 1, 0.0, np.zeros(6))
-    loop = closed_loop_rhs(lqr)
-    for t in np.r_[rng.uniform(-7, 13, 40), grid[:-1], grid[1:] + 2 * T]:
-        Y = rng.normal(size=(6, 6))
-        t_in = T / nodes * (np.floor(t * nodes / T) + 0.5)
-        x, u = tracker._reference(motion, t, t_in)
-        A, B = tracker._jacobians(body, x, u)
-        want = ((A - B @ lqr._gain(t, x, u)) @ Y).ravel()
-        # accuracy: as above (with LAPACK's 2 x 2 solve for the gain): measured equal bit for bit here
-        np.testing.assert_allclose(loop(t, Y.ravel(), t_in), want, rtol=1e-12, atol=1e-11)
-    assert closed_loop_rhs(tracker.periodic_lqr(body, _CircleMotion(body))) is None
-
-
-
 def _random_collocated_lqr(body, seed):
     """A collocated motion with random polynomials and inputs, and an LQR with a random grid of P
     (the rates need no solution)."""
@@ -379,6 +335,41 @@ def _random_collocated_lqr(body, seed):
     P = rng.normal(size=(grid.size, 6, 6))
     return tracker.PeriodicLQR(body, motion, tracker.DEFAULT_Q, tracker.DEFAULT_R, grid, P + np.swapaxes(P, 1, 2),
                                rng.normal(size=(grid.size - 1, 2, 6, 6)), 1, 0.0, np.zeros(6))
+
+
+def test_the_compiled_riccati_rhs_is_the_numpy_one_on_a_collocated_motion(body):
+    """lib.optimal.riccati against the numpy right-hand sides it compiles (the Riccati equation's,
+    the linearised closed loop's), on a motion with collocation polynomials and piecewise-constant
+    inputs and an LQR with a random grid of P (random: the rhs needs no solution), at times
+    inside, on and beyond the nodes, with heading turns."""
+    from lib.optimal.riccati import closed_loop_rhs, riccati_rhs
+    lqr = _random_collocated_lqr(body, 8)
+    motion, nodes, T = lqr.motion, lqr.motion.nodes, lqr.motion.period
+    rng = np.random.default_rng(9)
+    Q, R_inv = tracker.DEFAULT_Q, np.linalg.inv(tracker.DEFAULT_R)
+    fast = riccati_rhs(body, motion, Q, R_inv)
+    for t in np.r_[rng.uniform(-7, 13, 40), np.arange(-2, 18) * T / nodes]:
+        P = rng.normal(size=(6, 6))
+        P = P + P.T
+        t_in = T / nodes * (np.floor(t * nodes / T) + 0.5)           # inside t's input piece
+        A, B = tracker._jacobians(body, *tracker._reference(motion, t, t_in))
+        want = tracker._riccati_rate(A, B, P, R_inv, Q).ravel()
+        # accuracy: the same formulas in their order, compiled (the polynomial's sum over the basis
+        # written out where numpy's einsum may sum otherwise, numba's BLAS calls for the products):
+        # measured equal bit for bit over 420 times here; the bound allows rounding of terms up to 3e3
+        np.testing.assert_allclose(fast(t, P.ravel(), t_in), want, rtol=1e-12, atol=1e-11)
+    assert riccati_rhs(body, _CircleMotion(body), Q, R_inv) is None   # no polynomials: the numpy rhs
+    loop = closed_loop_rhs(lqr)
+    for t in np.r_[rng.uniform(-7, 13, 40), lqr.t[:-1], lqr.t[1:] + 2 * T]:
+        Y = rng.normal(size=(6, 6))
+        t_in = T / nodes * (np.floor(t * nodes / T) + 0.5)
+        x, u = tracker._reference(motion, t, t_in)
+        A, B = tracker._jacobians(body, x, u)
+        want = ((A - B @ lqr._gain(t, x, u)) @ Y).ravel()
+        # accuracy: as above (with LAPACK's 2 x 2 solve for the gain): measured equal bit for bit here
+        np.testing.assert_allclose(loop(t, Y.ravel(), t_in), want, rtol=1e-12, atol=1e-11)
+    assert closed_loop_rhs(tracker.periodic_lqr(body, _CircleMotion(body))) is None
+
 
 
 @pytest.mark.parametrize("F_max, beta_max", [(math.inf, None), (2.5, None), (math.inf, 0.5), (2.0, 0.3)])

@@ -181,18 +181,15 @@ def loop_rhs(lqr, F_max: float, beta_max: float | None):
         ``rhs(t, X, t_in)``: the rates (M, 6) of the states X (M, 6) (m, m, rad, m/s, m/s, rad/s)
         at t (s), the inputs read at ``t_in`` (s).
     """
-    motion, body = lqr.motion, lqr.body
-    if not all(hasattr(motion, a) for a in ("collocation", "nodes", "degree", "F", "beta")):
+    arrays = _lqr_arrays(lqr)
+    if arrays is None:
         return None
-    args = _motion_arrays(body, motion)
-    R, grid = np.ascontiguousarray(lqr.R, dtype=float), np.ascontiguousarray(lqr.t, dtype=float)
-    PG, dPG = np.ascontiguousarray(lqr.P, dtype=float), np.ascontiguousarray(lqr.dP, dtype=float)
     fmax, bmax = float(F_max), (-1.0 if beta_max is None else float(beta_max))
 
     def rhs(t, X, t_in):
         X = np.ascontiguousarray(X, dtype=float)
         out = np.empty_like(X)
-        _loop_rows(float(t), float(t_in), X, *args, R, grid, PG, dPG, fmax, bmax, out)
+        _loop_rows(float(t), float(t_in), X, *arrays, fmax, bmax, out)
         return out
     return rhs
 
@@ -243,18 +240,24 @@ def closed_loop_rhs(lqr):
     callable or None
         ``rhs(t, y, t_in)``: Y' (36,) for Y = y (36,), the inputs read at ``t_in`` (s).
     """
-    motion, body = lqr.motion, lqr.body
-    if not all(hasattr(motion, a) for a in ("collocation", "nodes", "degree", "F", "beta")):
+    arrays = _lqr_arrays(lqr)
+    if arrays is None:
         return None
-    args = _motion_arrays(body, motion)
-    R, grid = np.ascontiguousarray(lqr.R, dtype=float), np.ascontiguousarray(lqr.t, dtype=float)
-    PG, dPG = np.ascontiguousarray(lqr.P, dtype=float), np.ascontiguousarray(lqr.dP, dtype=float)
 
     def rhs(t, y, t_in):
         out = np.empty(36)
-        _closed_rhs(float(t), float(t_in), np.ascontiguousarray(y, dtype=float), *args, R, grid, PG, dPG, out)
+        _closed_rhs(float(t), float(t_in), np.ascontiguousarray(y, dtype=float), *arrays, out)
         return out
     return rhs
+
+
+def _lqr_arrays(lqr) -> tuple | None:
+    """The motion's arrays (:func:`_motion_arrays`), then R, the grid, P and dP of a periodic
+    LQR, for the kernels; None for a motion without collocation polynomials."""
+    if not all(hasattr(lqr.motion, a) for a in ("collocation", "nodes", "degree", "F", "beta")):
+        return None
+    return (*_motion_arrays(lqr.body, lqr.motion), *(np.ascontiguousarray(a, dtype=float)
+                                                     for a in (lqr.R, lqr.t, lqr.P, lqr.dP)))
 
 
 def _motion_arrays(body: Body, motion) -> tuple:
