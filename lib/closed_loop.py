@@ -161,16 +161,20 @@ def _demand(mass, drag, kp, kv, e, vd, ad, v):  # pragma: no cover (compiled)
 
 
 @numba.njit(cache=True)
+def _wrap(angle):  # pragma: no cover (compiled)
+    """:func:`lib.angles.wrap_angle`'s formula on one angle (rad): into (-pi, pi]."""
+    w = math.pi - (math.pi - angle) % (2 * math.pi)
+    return math.pi if w == -math.pi else w
+
+
+@numba.njit(cache=True)
 def _position(tx, ty, phi):  # pragma: no cover (compiled)
     """(25)-(26) on one demand: F = |(tau_x, tau_y)| (N) and beta (rad) wrapped to (-pi, pi], 0
-    where F = 0 (``lib.allocation.allocate``, with :func:`lib.angles.wrap_angle`'s formula)."""
+    where F = 0 (``lib.allocation.allocate``, with :func:`_wrap`)."""
     F = math.hypot(tx, ty)
     beta = 0.0
     if F > 0:
-        d = math.atan2(ty, tx) - phi
-        beta = math.pi - (math.pi - d) % (2 * math.pi)
-        if beta == -math.pi:
-            beta = math.pi
+        beta = _wrap(math.atan2(ty, tx) - phi)
     return F, beta
 
 

@@ -93,3 +93,19 @@ def test_the_key_reads_every_folder_of_the_library():
     assert book_cache._LIB == Path(lib.__file__).resolve().parent
     hashed = {p.relative_to(book_cache._LIB).parts[0] for p in book_cache._LIB.rglob("*.py")}
     assert {"rotation", "limits", "weighting", "dynamics", "params.py"} <= hashed
+
+
+def test_source_stamp_follows_the_contents_of_the_files(tmp_path):
+    """The stamp a compiled kernel closes over changes when a file it names changes, and only
+    then: the same contents give the same stamp, in any folder."""
+    from lib.machinery.cache import source_stamp
+    a, b = tmp_path / "a.py", tmp_path / "b.py"
+    a.write_text("x = 1\n")
+    b.write_text("y = 2\n")
+    first = source_stamp(a, b)
+    assert first == source_stamp(a, b) and 0 <= first < 2**60
+    (tmp_path / "c").mkdir()
+    (tmp_path / "c" / "a.py").write_text("x = 1\n")
+    assert source_stamp(tmp_path / "c" / "a.py", b) == first
+    a.write_text("x = 2\n")
+    assert source_stamp(a, b) != first

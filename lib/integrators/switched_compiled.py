@@ -34,13 +34,13 @@ tolerance (crossings, slides and kinks) and its exponents against the slow path.
 
 from __future__ import annotations
 
-import hashlib
 import math
 from pathlib import Path
 
 import numba
 import numpy as np
 
+from ..machinery.cache import source_stamp
 from .switched_events import T_TOL, _copy, _first_fired, _locate, _step
 from .switched_field import EPS_LAT, N_EVENTS, _field, _kin, _one_sided  # noqa: F401 (_kin: the tests')
 
@@ -140,10 +140,8 @@ def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2
 
 def _sources_stamp() -> int:
     """A hash of the three modules whose kernels ``_run`` compiles in (as a 60-bit integer)."""
-    h = hashlib.sha256()
-    for name in ("switched_field.py", "switched_events.py", "switched_compiled.py"):
-        h.update(Path(__file__).with_name(name).read_bytes())
-    return int(h.hexdigest()[:15], 16)
+    return source_stamp(*(Path(__file__).with_name(name)
+                          for name in ("switched_field.py", "switched_events.py", "switched_compiled.py")))
 
 
 def _make_run(stamp: int):

@@ -31,13 +31,34 @@ try:
 except ImportError:  # not POSIX: no lock, a key may then be computed twice at once
     fcntl = None
 
-__all__ = ["cached", "cached_timed", "cache_dir", "PAGE_VARIABLE"]
+__all__ = ["cached", "cached_timed", "cache_dir", "source_stamp", "PAGE_VARIABLE"]
 
 #: the environment variable that names the page being executed (``chapters/04_limits``)
 PAGE_VARIABLE = "BOOK_PAGE"
 
 _LIB = Path(__file__).resolve().parents[1]          # the package lib/, every folder of it
 
+
+def source_stamp(*files: Path) -> int:
+    """A hash of the contents of ``files`` as a 60-bit integer. Numba keys a kernel cached on
+    disk on its own file, not on the compiled functions it calls from other files: a kernel
+    made in a closure over this stamp of those files is keyed on them too, and compiled again
+    when one of them changes.
+
+    Parameters
+    ----------
+    *files : pathlib.Path
+        The source files.
+
+    Returns
+    -------
+    int
+        The stamp, >= 0.
+    """
+    h = hashlib.sha256()
+    for f in files:
+        h.update(Path(f).read_bytes())
+    return int(h.hexdigest()[:15], 16)
 
 def cache_dir(start: Path | None = None) -> Path:
     """``_build/.cache`` of the book that contains ``start`` (default: the working directory):

@@ -18,10 +18,14 @@ Units: SI (s, m, rad, N).
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numba
 import numpy as np
 
+from .. import closed_loop
+from ..closed_loop import _accel, _wrap
+from ..machinery.cache import source_stamp
 from ..params import Body
 from .collocation import tableau
 from .motion import NODE_SNAP
@@ -63,6 +67,13 @@ def _jac(t, t_in, period, nodes, snap, turns, F, beta, basis, colloc, body):  # 
     """A (6, 6) and B (6, 2) of (2)-(4) about the motion's state at t and its inputs at t_in, as
     ``lib.optimal.tracker._reference`` and ``_jacobians`` compute them."""
     x, f, b = _state(t, t_in, period, nodes, snap, turns, F, beta, basis, colloc)
+    return _jacobians(x, f, b, body)
+
+
+@numba.njit(cache=True)
+def _jacobians(x, f, b, body):  # pragma: no cover (compiled)
+    """A (6, 6) and B (6, 2) of (2)-(4) at the state x (6,) and the inputs (f, b), as
+    ``lib.optimal.tracker._jacobians``."""
     m, I, a, c, cphi = body[0], body[1], body[2], body[3], body[4]
     co, si = math.cos(x[2] + b), math.sin(x[2] + b)
     ia = a / I
@@ -116,48 +127,50 @@ def _gain(t, period, B, R, grid, PG, dPG):  # pragma: no cover (compiled)
     return np.linalg.solve(R, np.ascontiguousarray(B.T) @ P)
 
 
-@numba.njit(cache=True)
-def _wrap(angle):  # pragma: no cover (compiled)
-    """:func:`lib.angles.wrap_angle` of one angle: pi - (pi - angle) mod 2 pi (numba's np.mod,
-    numpy's floored remainder), -pi returned as pi."""
-    w = np.pi - np.mod(np.pi - angle, 2 * np.pi)
-    return np.pi if w == -np.pi else w
+def _make_loop_rows(stamp: int):
+    """The clipped loop's kernel, cached on disk by numba. It calls the plant (2)-(4) and the
+    wrap of the angle from :mod:`lib.closed_loop` (``_accel``, ``_wrap``), so it closes over
+    ``stamp``, the hash of that module (:func:`lib.machinery.cache.source_stamp`): numba keys
+    a cached kernel on its own file only, and on its closure's cells."""
 
-
-@numba.njit(cache=True)
-def _loop_rows(t, t_in, X, period, nodes, snap, turns, F, beta, basis, colloc, body, R, grid, PG, dPG,
-               F_max, beta_max, out):  # pragma: no cover (compiled)
-    """The clipped closed loop's rates (M, 6) into out for the states X (M, 6) at t, the motion's
-    inputs read at t_in, as ``lib.optimal.tracker._loop`` computes them: u = u* - K (x - x*), the
-    limits of ``_saturate`` (beta_max < 0: no angle limit), then (2)-(4)."""
-    xs, fs, bs = _state(t, t_in, period, nodes, snap, turns, F, beta, basis, colloc)
-    A, B = _jac(t, t_in, period, nodes, snap, turns, F, beta, basis, colloc, body)
-    K = _gain(t, period, B, R, grid, PG, dPG)
-    m, I, a, c, cphi = body[0], body[1], body[2], body[3], body[4]
-    for r in range(X.shape[0]):
-        u0, u1 = 0.0, 0.0
-        for j in range(6):
-            e = X[r, j] - xs[j]
-            u0 += K[0, j] * e
-            u1 += K[1, j] * e
-        f, b = fs - u0, bs - u1
-        if math.isnan(f) or math.isnan(b):
+    @numba.njit(cache=True)
+    def _loop_rows(t, t_in, X, period, nodes, snap, turns, F, beta, basis, colloc, body, R, grid, PG, dPG,
+                   F_max, beta_max, out):  # pragma: no cover (compiled)
+        """The clipped closed loop's rates (M, 6) into out for the states X (M, 6) at t, the
+        motion's inputs read at t_in, as ``lib.optimal.tracker._loop`` computes them:
+        u = u* - K (x - x*), the limits of ``_saturate`` (beta_max < 0: no angle limit), then
+        (2)-(4)."""
+        if stamp < 0:
+            return
+        xs, fs, bs = _state(t, t_in, period, nodes, snap, turns, F, beta, basis, colloc)
+        K = _gain(t, period, _jacobians(xs, fs, bs, body)[1], R, grid, PG, dPG)
+        m, I, a, c, cphi = body[0], body[1], body[2], body[3], body[4]
+        for r in range(X.shape[0]):
+            u0, u1 = 0.0, 0.0
             for j in range(6):
-                out[r, j] = math.nan
-            continue
-        if beta_max < 0.0:
-            if f < 0.0:
-                b = b + np.pi
-            f = abs(f)
-        f = min(max(f, 0.0), F_max)
-        b = _wrap(b)
-        if beta_max >= 0.0:
-            b = min(max(b, -beta_max), beta_max)
-        phi = X[r, 2]
-        out[r, 0], out[r, 1], out[r, 2] = X[r, 3], X[r, 4], X[r, 5]
-        out[r, 3] = (f * math.cos(phi + b) - c * X[r, 3]) / m
-        out[r, 4] = (f * math.sin(phi + b) - c * X[r, 4]) / m
-        out[r, 5] = (f * math.sin(b) * a - cphi * X[r, 5]) / I
+                e = X[r, j] - xs[j]
+                u0 += K[0, j] * e
+                u1 += K[1, j] * e
+            f, b = fs - u0, bs - u1
+            if math.isnan(f) or math.isnan(b):
+                for j in range(6):
+                    out[r, j] = math.nan
+                continue
+            if beta_max < 0.0:
+                if f < 0.0:
+                    b = b + np.pi
+                f = abs(f)
+            f = min(max(f, 0.0), F_max)
+            b = _wrap(b)
+            if beta_max >= 0.0:
+                b = min(max(b, -beta_max), beta_max)
+            out[r, 0], out[r, 1], out[r, 2] = X[r, 3], X[r, 4], X[r, 5]
+            out[r, 3], out[r, 4], out[r, 5] = _accel(f, b, X[r, 2], X[r, 3], X[r, 4], X[r, 5], m, I, c, cphi, a)
+
+    return _loop_rows
+
+
+_loop_rows = _make_loop_rows(source_stamp(Path(closed_loop.__file__)))
 
 
 def loop_rhs(lqr, F_max: float, beta_max: float | None):
