@@ -99,6 +99,7 @@ def test_a_frame_that_is_not_a_verdict_frame_is_refused(decided, change, match):
     (dict(locator="nearest"), "locator"),
     (dict(steps_per_period=8), "steps_per_period"),
     (dict(periodz=120), "periodz"),
+    (dict(periods=24, block=16), "two blocks"),                # the first decision's check, shared
 ])
 def test_bad_options_are_refused_before_any_run(decided, kwargs, match):
     with pytest.raises((ValueError, TypeError), match=match):
@@ -106,7 +107,7 @@ def test_bad_options_are_refused_before_any_run(decided, kwargs, match):
 
 
 def test_verdicts_without_the_measures_are_the_same_verdicts(decided):
-    # measure=False skips only the second run that measures ranges: every verdict, period,
+    # measure=False skips only the measures over the run: every verdict, period,
     # multiplier, exponent and orbit is the same to the bit, the unmeasured columns are NaN or NA
     lean = L.limit_verdicts(BODY, GAINS, EIGHT, np.radians([90.0, 60.0, 30.0]), measure=False)[0]
     same = ["regime", "period", "turns", "floquet", "lyapunov", "lyapunov_stderr", "returns", "crossings", "reason"]

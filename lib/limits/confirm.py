@@ -27,8 +27,8 @@ from ..machinery import checks
 from ..machinery.robustness import ROBUST_REL, perturbed
 from ..params import Body, Gains
 from ..trajectories import Reference
-from .runs import LOCATORS, STEPS_PER_PERIOD, _check_parts, _limits_arrays, _start_states, switched_runs
-from .verdicts import LIMIT_DEFAULTS, LimitVerdicts, _limit_chunk, _SwitchedMap, limit_verdicts
+from .runs import STEPS_PER_PERIOD, _check_parts, _limits_arrays, _start_states, switched_runs
+from .verdicts import LimitVerdicts, _limit_chunk, _procedure, _SwitchedMap, limit_verdicts
 
 __all__ = ["confirmed_limit_verdicts", "confirm_limit_verdicts", "same_orbit", "SAME_ORBIT_TOL", "MOVES",
            "QUICK_PERIODS"]
@@ -180,9 +180,7 @@ def confirm_limit_verdicts(body: Body, gains: Gains, ref: Reference, frame: pd.D
     missing = [c for c in _NEEDED if c not in frame.columns]
     if missing:
         raise ValueError(f"frame lacks the columns {missing} of a limit_verdicts frame")
-    o = checks.options(options, LIMIT_DEFAULTS, dict(transient=0, periods=2, block=2, max_period=1))
-    steps_per_period = checks.integer("steps_per_period", steps_per_period, minimum=16)
-    locator = checks.one_of("locator", locator, LOCATORS)
+    o, steps_per_period, locator = _procedure(options, steps_per_period, locator)
     S0 = _start_states(s0, len(frame))
     horizon = (frame.horizon.to_numpy(dtype=int) if "horizon" in frame.columns
                else np.full(len(frame), o["periods"]))

@@ -172,13 +172,8 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
         A named pair: ``frame`` (pandas.DataFrame), one row per pair, the columns above; ``runs``
         (:class:`SwitchedRuns`), the runs behind it, in the order of the pairs.
     """
-    o = checks.options(options, LIMIT_DEFAULTS, dict(transient=0, periods=2, block=2, max_period=1))
-    npr, blk, kmax = o["periods"], o["block"], o["max_period"]
-    if npr < 2 * blk or npr < 2 * kmax + 2:
-        raise ValueError(f"periods ({npr}) must cover two blocks ({blk}) and twice max_period ({kmax})")
+    o, steps_per_period, locator = _procedure(options, steps_per_period, locator)
     _check_parts(body, gains, ref)
-    steps_per_period = checks.integer("steps_per_period", steps_per_period, minimum=16)
-    locator = checks.one_of("locator", locator, LOCATORS)
     b, f = _limits_arrays(angle_limits, force_limits)
     S0 = _start_states(s0, b.size)
     measure = checks.flag("measure", measure)
@@ -189,6 +184,17 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
     if len(parts) == 1:
         return LimitVerdicts(*parts[0])
     return LimitVerdicts(pd.concat([p[0] for p in parts], ignore_index=True), _concat_runs([p[1] for p in parts]))
+
+
+def _procedure(options: dict, steps_per_period, locator) -> tuple[dict, int, str]:
+    """The checked options of the procedure (:data:`LIMIT_DEFAULTS`), steps per period and
+    locator of :func:`limit_verdicts` (and of the decisions that confirm its verdicts)."""
+    o = checks.options(options, LIMIT_DEFAULTS, dict(transient=0, periods=2, block=2, max_period=1))
+    npr, blk, kmax = o["periods"], o["block"], o["max_period"]
+    if npr < 2 * blk or npr < 2 * kmax + 2:
+        raise ValueError(f"periods ({npr}) must cover two blocks ({blk}) and twice max_period ({kmax})")
+    return (o, checks.integer("steps_per_period", steps_per_period, minimum=16),
+            checks.one_of("locator", locator, LOCATORS))
 
 
 def _limit_chunk(b, f, S0, *, body, gains, ref, o, steps_per_period, locator, measure=True):
@@ -260,7 +266,7 @@ def _orbit_measures(orb: dict) -> dict:
 MEASURE_SAMPLES = 40
 
 
-def _over_the_run(pmap: "_SwitchedMap", start, orb: dict, periods: int, block: int, runs=None) -> dict:
+def _over_the_run(pmap: "_SwitchedMap", start, orb: dict, periods: int, block: int, runs: SwitchedRuns) -> dict:
     """What the section alone cannot show, sampled ``MEASURE_SAMPLES`` times a period: the
     range of p (rad) and the largest position error (m) over the whole orbit (its k periods
     from the orbit's point) or, without one, over the observed run (``periods`` periods from
@@ -276,7 +282,7 @@ def _over_the_run(pmap: "_SwitchedMap", start, orb: dict, periods: int, block: i
     groups += [(np.flatnonzero(orb["found"] & (orb["lag"] == k)), int(k), orb["x"])
                for k in np.unique(orb["lag"][orb["found"]])]
     S = MEASURE_SAMPLES
-    own = runs is not None and runs.recorded is not None
+    own = runs.recorded is not None
     for j, (rows, k, x0) in enumerate(groups):
         if rows.size == 0:
             continue
