@@ -410,3 +410,12 @@ def test_the_compiled_loop_raises_on_a_non_finite_rate(body):
     X[1, 0] = np.nan
     with pytest.raises(SimulationError, match="non-finite at t = 0.3"):
         tracker._loop(lqr, 2.0, 0.5, 2)(0.0, 0.625)(0.3, X.ravel())
+
+
+@pytest.mark.parametrize("F_max, beta_max, match", [(0.0, None, "F_max"), (float("nan"), None, "F_max"),
+                                                    (2.0, -0.1, "beta_max"), (2.0, 4.0, "beta_max")])
+def test_the_compiled_loop_refuses_bad_limits(body, F_max, beta_max, match):
+    from lib.optimal import riccati
+    with pytest.raises(ValueError, match=match):
+        riccati.loop_rhs(_random_collocated_lqr(body, 14), F_max, beta_max)
+

@@ -25,6 +25,7 @@ import numpy as np
 
 from .. import closed_loop
 from ..closed_loop import _accel, _wrap
+from ..machinery import checks
 from ..machinery.cache import source_stamp
 from ..params import Body
 from .collocation import tableau
@@ -194,10 +195,12 @@ def loop_rhs(lqr, F_max: float, beta_max: float | None):
         ``rhs(t, X, t_in)``: the rates (M, 6) of the states X (M, 6) (m, m, rad, m/s, m/s, rad/s)
         at t (s), the inputs read at ``t_in`` (s).
     """
+    fmax = checks.number("F_max", F_max, positive=True, finite=False, unit="N")
+    bmax = -1.0 if beta_max is None else checks.number("beta_max", beta_max, positive=True, maximum=math.pi,
+                                                       unit="rad")
     arrays = _lqr_arrays(lqr)
     if arrays is None:
         return None
-    fmax, bmax = float(F_max), (-1.0 if beta_max is None else float(beta_max))
 
     def rhs(t, X, t_in):
         X = np.ascontiguousarray(X, dtype=float)
