@@ -9,6 +9,7 @@ import pytest
 from lib import model
 from lib.optimal import collocation as col
 from lib.optimal import motion as mo
+from lib.optimal import study
 from lib.params import Body
 from lib.trajectories import make
 
@@ -178,6 +179,27 @@ def test_a_smaller_angle_limit_cannot_do_better_and_warm_starts_match_cold_ones(
     assert [s[0] for s in cold.starts] == ["paper", "force", "shifted+", "shifted-"]
     # reason: a property (the same optimum), 1e-6 relative for IPOPT's stopping (measured 2.2e-15)
     assert warm.rms_error <= cold.rms_error * (1 + 1e-6)
+
+
+def test_the_mesh_study_refines_the_coarse_optimum_and_finds_the_cold_one():
+    """motion_convergence solves the coarsest mesh from every start and each finer one from the
+    mesh before alone: the finer row must be the optimum the cold starts find on that mesh."""
+    fr = study.motion_convergence(BODY, R, THETA, 30 * DEG, 4.0, nodes=(16, 32))
+    cold = mo.periodic_motion(BODY, R, THETA, F_max=4.0, beta_max=30 * DEG, nodes=32)
+    assert fr.nodes.tolist() == [16, 32]
+    # reason: a property (the same optimum), 1e-6 relative for IPOPT's stopping (measured 1e-15)
+    assert fr.rms_error[1] <= cold.rms_error * (1 + 1e-6)
+    # reason: the cap, with 1e-8 relative for IPOPT's constraint tolerance
+    assert (fr.F_peak <= 4.0 * (1 + 1e-8)).all()
+    # order 6 at the nodes: the finer mesh returns closer (a factor 16 of the 64 asked, as above)
+    assert fr.return_error[1] < fr.return_error[0] / 16
+
+
+@pytest.mark.parametrize("nodes", [(40, 40), (80, 40)])
+def test_the_mesh_study_refuses_meshes_that_do_not_refine(monkeypatch, nodes):
+    monkeypatch.setattr(study, "periodic_motion", lambda *a, **k: pytest.fail("solved before the check"))
+    with pytest.raises(ValueError, match="nodes must increase"):
+        study.motion_convergence(BODY, R, THETA, 30 * DEG, 4.0, nodes=nodes)
 
 
 def test_no_accepted_start_raises(monkeypatch):

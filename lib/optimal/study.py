@@ -150,15 +150,39 @@ def motion_convergence(body: Body, R: float, Theta: float, beta_max: float, F_ma
     the book's integrator over one period (:func:`lib.optimal.motion.verify_motion`, the
     max-norm of the state's mismatch: m, rad, m/s, rad/s).
 
+    Mesh refinement of one optimum: the coarsest mesh is solved from every start of
+    :func:`lib.optimal.motion.periodic_motion`, each finer one from the optimum of the mesh
+    before it alone (interpolated onto the finer mesh), so that every row refines the same
+    motion instead of letting the starts choose among local optima anew.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    R, Theta : float
+        The path (m, rad/s).
+    beta_max : float
+        Angle limit (rad).
+    F_max : float or None
+        Force cap (N); None for none.
+    nodes : sequence of int
+        The meshes (intervals a period), increasing, each >= 8.
+    kind : str
+        ``"eight"`` or ``"circle"``.
+
     Returns
     -------
     pandas.DataFrame
         Columns nodes, rms_error, max_error, F_peak, return_error.
     """
     R, Theta = _check(body, R, Theta, kind)
-    rows = []
-    for n in [checks.integer("nodes", n, minimum=8) for n in np.atleast_1d(nodes)]:
-        m: PeriodicMotion = periodic_motion(body, R, Theta, kind=kind, F_max=F_max, beta_max=beta_max, nodes=n)
+    meshes = [checks.integer("nodes", n, minimum=8) for n in np.atleast_1d(nodes)]
+    if any(b <= a for a, b in zip(meshes, meshes[1:])):
+        raise ValueError(f"nodes must increase (each mesh refines the one before), got {meshes}")
+    rows, m = [], None
+    for n in meshes:
+        opts = {} if m is None else dict(starts=(), guess=m)
+        m = periodic_motion(body, R, Theta, kind=kind, F_max=F_max, beta_max=beta_max, nodes=n, **opts)
         rows.append(dict(nodes=n, rms_error=m.rms_error, max_error=m.max_error, F_peak=float(m.F.max()),
                          return_error=verify_motion(body, m)))
     return pd.DataFrame(rows)
