@@ -17,7 +17,7 @@ The flow is integrated by the fourth-order Magnus method (two Gauss points, one 
 each step's exp(Omega) is exact (Omega^2 = d I), so the step is stable however stiff the
 heading's relaxation (|w| / eps up to hundreds per second). Its Jacobian is exact too:
 d phi_end / d phi_start = det(E) / |E x|^2 = 1 / |E x|^2 per step. The steps run in one compiled
-loop (:func:`_flow_kernel`), point by point; ``tests/test_percussion_sweep.py`` checks it against
+loop (``_flow_kernel``), point by point; ``tests/test_percussion_sweep.py`` checks it against
 the step written out in numpy.
 """
 
