@@ -9,7 +9,9 @@ import pytest
 
 from lib import trajectories
 from lib.allocation import Limits
+from lib.integrators.smooth import SimulationError
 from lib.optimal import compare, study
+from lib.optimal.loop import BLOWUP, FlowMap
 from lib.params import Body, Gains
 from lib.tracking.runs import force_cap_sweep
 
@@ -26,6 +28,41 @@ def test_the_paper_law_under_the_cap_is_periodic_and_measures_as_the_cap_sweep()
     assert row["max_error"] == pytest.approx(float(sweep.pos_err_max.iloc[0]), abs=2e-3)
     assert row["F_peak"] == 4.0                      # exact: the applied force is clipped at the cap
     assert 0.0 < row["rms_error"] < row["max_error"]
+
+
+@pytest.mark.parametrize("angle, cap", [(None, None), (None, 4.0), (30, None), (30, 4.0)])
+def test_the_law_for_p_compiled_period_is_the_numpy_rk4_steps(angle, cap):
+    """The law for P's compiled period (LawLoop.period_end) against FlowMap's RK4 steps of the same
+    field in numpy, on rows far enough from the path that the clip and the anti-windup act."""
+    ref = trajectories.eight(2.0, math.pi / 4)
+    loop = compare.law_loop(BODY, GAINS, ref, "percussion", Limits(cap, None if angle is None else math.radians(angle)))
+    rng = np.random.default_rng(3)
+    x = loop.s0 + rng.normal(scale=[0.5, 0.5, 1.0, 0.5, 0.5, 1.0, 1.0], size=(5, 7))
+    fast = FlowMap(loop.rates, ref.period, steps=256, period_end=loop.period_end)
+    slow = FlowMap(loop.rates, ref.period, steps=256)
+    a, b = fast.advance(np.zeros(5, int), x, 2), slow.advance(np.zeros(5, int), x, 2)
+    # accuracy: the same stage sums in the same order on the same compiled field, to rounding over
+    # 512 steps: 1e-10 relative (measured 0 here; a compiler may fuse a multiply-add elsewhere)
+    np.testing.assert_allclose(a, b, rtol=1e-10, atol=1e-10)
+    F, _ = loop.inputs(np.zeros(5), x)
+    if cap is not None:
+        assert (F >= cap * (1 - 1e-12)).any()    # the cap binds at some start (exact: the clip's own value)
+
+
+def test_the_law_for_p_compiled_period_names_a_blow_up_as_the_numpy_steps_do():
+    ref = trajectories.eight(2.0, math.pi / 4)
+    loop = compare.law_loop(BODY, GAINS, ref, "percussion", Limits(4.0, None))
+    x = loop.s0[None, :] + 0.0
+    x[0, 3] = 2 * BLOWUP
+    for flow in (FlowMap(loop.rates, ref.period, steps=64, period_end=loop.period_end),
+                 FlowMap(loop.rates, ref.period, steps=64)):
+        with pytest.raises(SimulationError, match=r"a state beyond 1e\+08 at t = 0 s"):
+            flow.end(x)
+    x[0, 3] = np.nan
+    for flow in (FlowMap(loop.rates, ref.period, steps=64, period_end=loop.period_end),
+                 FlowMap(loop.rates, ref.period, steps=64)):
+        with pytest.raises(SimulationError, match="non-finite at t = .* s for point 0"):
+            flow.end(x)
 
 
 def test_law_row_names_a_law_it_does_not_decide():

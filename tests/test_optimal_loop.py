@@ -87,7 +87,7 @@ def test_a_loop_that_never_settles_is_undecided_not_periodic():
 @pytest.mark.parametrize("kw, name", [({"period": 0.0}, "period"), ({"s0": [np.nan] * 6}, "s0"),
                                       ({"reference_turns": 0.5}, "reference_turns"),
                                       ({"transient": 0}, "transient"), ({"bogus": 1}, "bogus"),
-                                      ({"rates": 3.0}, "rates")])
+                                      ({"rates": 3.0}, "rates"), ({"period_end": 3.0}, "period_end")])
 def test_bad_arguments_are_refused_before_any_integration(kw, name):
     args = dict(rates=lambda t, s: pytest.fail("integrated"), period=1.0, s0=np.zeros(6))
     args.update(kw)

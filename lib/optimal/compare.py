@@ -15,8 +15,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Callable
 
+import numba
 import numpy as np
 import pandas as pd
 
@@ -25,13 +27,16 @@ from ..closed_loop import ClosedLoop, limited_weighted_field, reference_of
 from ..control import computed_torque
 from ..limits.runs import switched_runs
 from ..limits.verdicts import limit_verdicts
+from ..integrators.smooth import SimulationError
 from ..machinery import checks
+from ..machinery.cache import source_stamp
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
-from ..percussion.full_loop import limited_field
+from ..percussion import full_loop
+from ..percussion.full_loop import _limited_args, _rows_field, limited_field
 from ..percussion.law import ANTI_WINDUP_TIME, closed_loop_rates, error_polynomial
 from ..trajectories import POSITIONS, heading_turns, make
 from .bound import cap_bound
-from .loop import FlowMap, loop_verdict, run_periods, steady_measures
+from .loop import BLOWUP, FlowMap, loop_verdict, run_periods, steady_measures
 from .study import PAPER_CAP, SETTINGS, limit_motions, setting_label
 from .tracker import periodic_lqr, track_motion
 from .verdict import basin, motion_verdict
@@ -50,11 +55,75 @@ THRUST0 = 0.5
 @dataclass(frozen=True)
 class LawLoop:
     """One law's closed loop: ``rates(t, s)`` and ``inputs(t, s) -> (F, beta)`` vectorised over
-    rows of states (d = 6, or 7 with the law for P's thrust state), its start ``s0`` (d,)."""
+    rows of states (d = 6, or 7 with the law for P's thrust state), its start ``s0`` (d,), and
+    optionally ``period_end(x, T, steps)``, the fixed RK4 steps of ``rates`` over a period compiled
+    (:class:`lib.optimal.loop.FlowMap`)."""
 
     rates: Callable
     inputs: Callable
     s0: np.ndarray
+    period_end: Callable | None = None
+
+
+def _make_rk4_rows(stamp: int):
+    """The kernel of :func:`_percussion_period_end`, cached on disk by numba; it closes over
+    ``stamp``, the hash of ``lib/percussion/full_loop.py`` whose field it calls (numba keys a
+    cached kernel on its own file only)."""
+
+    @numba.njit(cache=True)
+    def run(Y, n, h, blowup, R, Th, p, q, fc, ac, taw, circle):
+        """n classical RK4 steps of h (s) from t = 0 on every row of Y (M, 7), in place, with the
+        stage sums of :func:`lib.integrators.batch.steps` in their order. Returns (0, 0, 0), or
+        (1, t, row) where a stage's state exceeds ``blowup`` in magnitude, or (2, t, row) where a
+        step ends non-finite."""
+        if stamp < 0:
+            return 0, 0.0, 0
+        M = Y.shape[0]
+        K = np.empty((4, M, 7))
+        yi = np.empty((M, 7))
+        for k in range(n):
+            t = k * h
+            for i in range(4):
+                a = 0.0 if i == 0 else (h * 1.0 if i == 3 else h * 0.5)
+                for r in range(M):
+                    for c in range(7):
+                        yi[r, c] = Y[r, c] if i == 0 else Y[r, c] + a * K[i - 1, r, c]
+                        if abs(yi[r, c]) > blowup:
+                            return 1, t + (0.0, 0.5, 0.5, 1.0)[i] * h, r
+                _rows_field(t + (0.0, 0.5, 0.5, 1.0)[i] * h, yi, K[i], R, Th, p, q, fc, ac, taw, circle)
+            hb = h / 6.0
+            for r in range(M):
+                for c in range(7):
+                    Y[r, c] = Y[r, c] + hb * (((1.0 * K[0, r, c] + 2.0 * K[1, r, c]) + 2.0 * K[2, r, c])
+                                              + 1.0 * K[3, r, c])
+                    if not np.isfinite(Y[r, c]):
+                        return 2, (k + 1) * h, r
+        return 0, 0.0, 0
+    return run
+
+
+_rk4_rows = _make_rk4_rows(source_stamp(Path(full_loop.__file__)))
+
+
+def _percussion_period_end(body: Body, gains: Gains, ref, limits: Limits) -> Callable:
+    """``period_end(x, T, steps)`` of the law for P under ``limits``: the RK4 steps that
+    :class:`lib.optimal.loop.FlowMap` takes with ``steps`` a period (the largest step <= T / steps
+    that divides T), compiled on the field of :func:`lib.percussion.full_loop.limited_field`; a
+    state beyond :data:`lib.optimal.loop.BLOWUP` or not finite raises ``SimulationError`` naming
+    the time, as the numpy steps do."""
+    args = _limited_args(body, gains, ref, limits, ANTI_WINDUP_TIME)
+
+    def period_end(x, T, steps):
+        n = int(np.ceil(T / (T / steps)))
+        Y = np.array(x, dtype=float, order="C").reshape(-1, 7)
+        code, t, row = _rk4_rows(Y, n, T / n, BLOWUP, *args)
+        if code == 1:
+            raise SimulationError(f"the closed loop blew up: a state beyond {BLOWUP:g} at t = {t:.6g} s")
+        if code == 2:
+            raise SimulationError(f"the closed loop blew up: batch integration became non-finite at t = {t:.6g} s "
+                                  f"for point {row}")
+        return Y.reshape(np.shape(x))
+    return period_end
 
 
 def law_loop(body: Body, gains: Gains, ref, law: str, limits: Limits) -> LawLoop:
@@ -101,7 +170,7 @@ def law_loop(body: Body, gains: Gains, ref, law: str, limits: Limits) -> LawLoop
     # the fixed-step loops call the rates at one time on a few rows: the compiled field, the same to
     # rounding; the inputs, read once over a recorded run, from lib.percussion.law
     return LawLoop(limited_field(body, gains, ref, limits, ANTI_WINDUP_TIME), lambda t, s: both(t, s)[1:],
-                   np.r_[s0, THRUST0])
+                   np.r_[s0, THRUST0], _percussion_period_end(body, gains, ref, limits))
 
 
 def _measure(flow: FlowMap, loop: LawLoop, x, n_periods: int, ref, limits: Limits) -> dict:
@@ -146,11 +215,11 @@ def law_row(body: Body, gains: Gains, ref, law: str, limits: Limits, *, measure_
     checks.one_of("law", law, LAWS[1:3])
     loop = law_loop(body, gains, ref, law, limits)
     v = loop_verdict(loop.rates, ref.period, loop.s0, reference_turns=heading_turns(ref), steps=LAW_STEPS[law],
-                     **LAW_OPTIONS)
+                     period_end=loop.period_end, **LAW_OPTIONS)
     if v.reason.startswith("diverged"):
         return dict(regime="undecided", reason=v.reason, floquet=np.nan, max_error=np.inf, rms_error=np.inf,
                     F_peak=np.nan, beta_peak=np.nan, p_range=np.nan)
-    flow = FlowMap(loop.rates, ref.period, steps=LAW_STEPS[law])
+    flow = FlowMap(loop.rates, ref.period, steps=LAW_STEPS[law], period_end=loop.period_end)
     found = bool(np.isfinite(v.orbit).all())
     meas = _measure(flow, loop, v.orbit if found else v.section[-1], v.period if found else measure_periods,
                     ref, limits)

@@ -80,12 +80,20 @@ def _integrate(rates: Rates, x: np.ndarray, t0: float, t1: float, rtol: float, a
 class FlowMap:
     """The period map of a T-periodic field: ``advance(idx, x, k)`` integrates the rows x (M, d)
     over k periods each (adaptive DOP853, all rows at once), the heading (column ``turn_axis``)
-    continuous. A :class:`lib.dynamics.verdicts.PeriodMap`; one field for every row (``idx`` unused)."""
+    continuous. A :class:`lib.dynamics.verdicts.PeriodMap`; one field for every row (``idx`` unused).
+    With fixed ``steps``, ``period_end(x, T, steps)`` (optional) is a compiled run of the same RK4
+    steps to the period's end, used where no step is recorded (:meth:`end`)."""
 
     def __init__(self, rates: Rates, period: float, *, turn_axis: int = 2, rtol: float = 1e-10,
-                 atol: float = 1e-10, steps: int = 0):
+                 atol: float = 1e-10, steps: int = 0, period_end: Callable | None = None):
         self.rates, self.period, self.turn_axis = rates, float(period), turn_axis
-        self.rtol, self.atol, self.steps = rtol, atol, steps
+        self.rtol, self.atol, self.steps, self.period_end = rtol, atol, steps, period_end
+
+    def end(self, x: np.ndarray) -> np.ndarray:
+        """The rows x (M, d) at t = 0 after one period."""
+        if self.steps and self.period_end is not None:
+            return self.period_end(x, self.period, self.steps)
+        return self.one(x)[0]
 
     def one(self, x: np.ndarray, samples: int = 0):
         """One period from the rows x (M, d) at t = 0: the end (M, d) and, with ``samples`` > 0
@@ -106,7 +114,7 @@ class FlowMap:
         k = np.broadcast_to(np.asarray(k, dtype=int), (x.shape[0],))
         for j in range(int(k.max(initial=0))):
             go = k > j
-            x[go] = self.one(x[go])[0]
+            x[go] = self.end(x[go])
         return x
 
 
@@ -162,7 +170,7 @@ def run_periods(flow: FlowMap, s0, n_periods: int, *, samples: int = 0, record: 
     sec, ts, ys = [x[0].copy()], [], []
     for j in range(n_periods):
         keep = j >= n_periods - record
-        end, t, y = flow.one(x, samples if keep else 0)
+        end, t, y = flow.one(x, samples) if keep else (flow.end(x), None, None)
         if keep and t is not None:
             ts.append(t + (len(ts)) * flow.period)
             ys.append(y[:, 0])
@@ -173,7 +181,8 @@ def run_periods(flow: FlowMap, s0, n_periods: int, *, samples: int = 0, record: 
     return np.array(sec), np.concatenate(ts), np.concatenate(ys)
 
 
-def loop_verdict(rates: Rates, period: float, s0, *, reference_turns: int = 0, **options) -> LoopVerdict:
+def loop_verdict(rates: Rates, period: float, s0, *, reference_turns: int = 0, period_end: Callable | None = None,
+                 **options) -> LoopVerdict:
     """The long-run regime of the closed loop s' = rates(t, s) (T = ``period`` s) from s0 (d,), by
     the book's orbit procedure (:func:`lib.dynamics.verdicts.find_orbits`) on :class:`FlowMap`:
     ``transient`` periods, then the last ``history`` section states searched for an orbit of
@@ -195,6 +204,8 @@ def loop_verdict(rates: Rates, period: float, s0, *, reference_turns: int = 0, *
         The start (d,), heading in column 2.
     reference_turns : int
         Whole turns of the path's heading per period.
+    period_end : callable, optional
+        With fixed ``steps``: the same steps over a period compiled (:class:`FlowMap`).
     **options
         Keys of :data:`LOOP_OPTIONS`.
 
@@ -205,12 +216,14 @@ def loop_verdict(rates: Rates, period: float, s0, *, reference_turns: int = 0, *
     o = checks.options(options, LOOP_OPTIONS, minima=_INTEGER_OPTIONS)
     if not callable(rates):
         raise TypeError(f"rates must be a callable (t, s) -> s', got {type(rates).__name__}")
+    if period_end is not None and not callable(period_end):
+        raise TypeError(f"period_end must be None or a callable (x, T, steps) -> x, got {type(period_end).__name__}")
     period = checks.number("period", period, positive=True, unit="s")
     s0 = checks.array("s0", s0, ndim=1)
     reference_turns = checks.integer("reference_turns", reference_turns)
     d = s0.size
     nan = np.full(d, np.nan)
-    flow = FlowMap(rates, period, rtol=o["rtol"], atol=o["atol"], steps=o["steps"])
+    flow = FlowMap(rates, period, rtol=o["rtol"], atol=o["atol"], steps=o["steps"], period_end=period_end)
     try:
         sec, _, _ = run_periods(flow, s0, o["transient"] + o["history"])
     except SimulationError as err:

@@ -43,9 +43,7 @@ from .law import error_polynomial
 from .point import centre_of_percussion, lateral_drag_speed, point_accel, point_state
 
 __all__ = ["FULL_LOOP_OPTIONS", "THRUST0", "MAX_STEPS", "grid_sample", "compiled_rates", "limited_field",
-           "steps_per_period",
-           "start_error", "FullLoopMap",
-           "full_loop_verdicts", "compare_with_zero_dynamics"]
+           "steps_per_period", "start_error", "FullLoopMap", "full_loop_verdicts", "compare_with_zero_dynamics"]
 
 #: the thrust state at the start (N), as Chapter 7 starts the law for P
 THRUST0 = 0.5
@@ -131,17 +129,20 @@ def limited_field(body: Body, gains: Gains, ref, limits: Limits | None = None, a
     callable
         ``rates(t, Y)``: t (s) a float, Y (..., 7) the states; the rates, of Y's shape.
     """
+    args = _limited_args(body, gains, ref, limits, anti_windup)
+    def rates(t, Y):
+        out = np.empty_like(Y := np.ascontiguousarray(Y, dtype=float))
+        _rows_field(float(t), Y.reshape(-1, 7), out.reshape(-1, 7), *args)
+        return out
+    return rates
+
+
+def _limited_args(body, gains, ref, limits, anti_windup) -> tuple:  # _rows_field's (R, Th, p, q, fc, ac, taw, circle)
     checks.one_of("ref (its path's kind)", getattr(ref, "_kind", None), ("eight", "circle"))
     limits = checks.instance("limits", Limits() if limits is None else limits, Limits)
     fc, ac = (d if v is None else float(v) for v, d in ((limits.force, math.inf), (limits.angle, math.pi)))
     taw = 0.0 if anti_windup is None else checks.number("anti_windup", anti_windup, positive=True, unit="s")
-    p, q, R, Th, circle = _params(body, gains), _plant(body), float(ref.R), float(ref.theta), ref._kind == "circle"
-
-    def rates(t, Y):
-        out = np.empty_like(Y := np.ascontiguousarray(Y, dtype=float))
-        _rows_field(float(t), Y.reshape(-1, 7), out.reshape(-1, 7), R, Th, p, q, fc, ac, taw, circle)
-        return out
-    return rates
+    return float(ref.R), float(ref.theta), _params(body, gains), _plant(body), fc, ac, taw, ref._kind == "circle"
 
 
 @numba.njit(cache=True)
@@ -181,9 +182,8 @@ def _periods(x, R, Th, steps, p, pl, k, fmax, emax):
 
 
 def _params(body: Body, gains: Gains) -> np.ndarray:
-    co = error_polynomial(body, gains)
     return np.r_[body.m, body.I, body.a, body.c, body.c_phi, centre_of_percussion(body), lateral_drag_speed(body),
-                 co[0], co[1]].astype(float)
+                 error_polynomial(body, gains).ravel()].astype(float)
 
 
 def _plant(body: Body) -> np.ndarray:
