@@ -47,10 +47,10 @@ LAST = ("errata", "report", "intro")
 #: depend on the threads (``make test-portable`` runs the tests on one).
 KERNEL_ENV = {"OPENBLAS_NUM_THREADS": "1"}
 #: a page's CPU time (s), measured (the log of ``make book`` from an empty ``_build``, 2026-11-27,
-#: after Chapter 8's compiled closed loop), to start the longest first (unknown pages first of all)
-COST = {"chapters/04_limits": 118, "chapters/05_stability": 90, "chapters/08_optimal": 44,
-        "chapters/03_tracking": 19, "chapters/06_allocation": 15, "chapters/07_percussion": 15,
-        "chapters/02_controllability": 11, "chapters/01_model": 4, "methods": 2}
+#: after Chapter 8's mesh study and compiled law for P), to start the longest first (unknown pages first of all)
+COST = {"chapters/04_limits": 117, "chapters/05_stability": 91, "chapters/08_optimal": 31,
+        "chapters/03_tracking": 17, "chapters/06_allocation": 14, "chapters/07_percussion": 13,
+        "chapters/02_controllability": 10, "chapters/01_model": 3, "methods": 2}
 
 
 def kernel_env(jobs: int, cores: int | None = None) -> dict:
