@@ -17,7 +17,7 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-__all__ = ["Tableau", "RK4", "dop853", "steps", "integrate"]
+__all__ = ["Tableau", "RK4", "dop853", "steps", "integrate", "fixed_steps", "nonfinite_message"]
 
 
 @dataclass(frozen=True)
@@ -125,14 +125,51 @@ def integrate(rates: Rates, y0, t0: float, t_end: float, dt: float, tableau: Tab
     y : numpy.ndarray
         Recorded states, (n,) + y0.shape.
     """
-    n_steps = int(np.ceil((t_end - t0) / dt))
-    h = (t_end - t0) / n_steps
+    n_steps, h = fixed_steps(t0, t_end, dt)
     ts, ys = [t0], [np.array(y0, dtype=np.result_type(np.asarray(y0), float))]
     for k, (t, y) in enumerate(steps(rates, y0, t0, h, n_steps, tableau), start=1):
         if not np.all(np.isfinite(y)):
             bad = np.flatnonzero(~np.all(np.isfinite(y.reshape(y.shape[0], -1)), axis=1)) if y.ndim else [0]
-            raise FloatingPointError(f"batch integration became non-finite at t = {t:.6g} s for point {int(bad[0])}")
+            raise FloatingPointError(nonfinite_message(t, int(bad[0])))
         if k % record_every == 0 or k == n_steps:
             ts.append(t)
             ys.append(y)
     return np.array(ts), np.array(ys)
+
+
+def fixed_steps(t0: float, t_end: float, dt: float) -> tuple[int, float]:
+    """The steps :func:`integrate` takes from t0 to ``t_end``: their number n and size h, the
+    largest h <= ``dt`` that divides the interval.
+
+    Parameters
+    ----------
+    t0, t_end : float
+        Start and end times.
+    dt : float
+        Largest step.
+
+    Returns
+    -------
+    tuple
+        (n, h).
+    """
+    n_steps = int(np.ceil((t_end - t0) / dt))
+    return n_steps, (t_end - t0) / n_steps
+
+
+def nonfinite_message(t: float, point: int) -> str:
+    """What :func:`integrate` says of a state that became non-finite at time t at ``point``.
+
+    Parameters
+    ----------
+    t : float
+        The time (s).
+    point : int
+        The point's index along the first axis.
+
+    Returns
+    -------
+    str
+        The message.
+    """
+    return f"batch integration became non-finite at t = {t:.6g} s for point {point}"

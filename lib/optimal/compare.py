@@ -25,9 +25,9 @@ import pandas as pd
 from ..allocation import Allocation, Limits, allocate
 from ..closed_loop import ClosedLoop, limited_weighted_field, reference_of
 from ..control import computed_torque
+from ..integrators.batch import RK4
 from ..limits.runs import switched_runs
 from ..limits.verdicts import limit_verdicts
-from ..integrators.smooth import SimulationError
 from ..machinery import checks
 from ..machinery.cache import source_stamp
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
@@ -36,7 +36,7 @@ from ..percussion.full_loop import _limited_args, _rows_field, limited_field
 from ..percussion.law import ANTI_WINDUP_TIME, closed_loop_rates, error_polynomial
 from ..trajectories import POSITIONS, heading_turns, make
 from .bound import cap_bound
-from .loop import BLOWUP, FlowMap, loop_verdict, run_periods, steady_measures
+from .loop import FlowMap, loop_verdict, run_periods, steady_measures
 from .study import PAPER_CAP, SETTINGS, limit_motions, setting_label
 from .tracker import periodic_lqr, track_motion
 from .verdict import basin, motion_verdict
@@ -56,8 +56,7 @@ THRUST0 = 0.5
 class LawLoop:
     """One law's closed loop: ``rates(t, s)`` and ``inputs(t, s) -> (F, beta)`` vectorised over
     rows of states (d = 6, or 7 with the law for P's thrust state), its start ``s0`` (d,), and
-    optionally ``period_end(x, T, steps)``, the fixed RK4 steps of ``rates`` over a period compiled
-    (:class:`lib.optimal.loop.FlowMap`)."""
+    optionally ``period_end``, the fixed RK4 steps of ``rates`` compiled (:class:`lib.optimal.loop.FlowMap`)."""
 
     rates: Callable
     inputs: Callable
@@ -65,64 +64,59 @@ class LawLoop:
     period_end: Callable | None = None
 
 
-def _make_rk4_rows(stamp: int):
+def _make_rows_steps(stamp: int):
     """The kernel of :func:`_percussion_period_end`, cached on disk by numba; it closes over
     ``stamp``, the hash of ``lib/percussion/full_loop.py`` whose field it calls (numba keys a
     cached kernel on its own file only)."""
 
     @numba.njit(cache=True)
-    def run(Y, n, h, blowup, R, Th, p, q, fc, ac, taw, circle):
-        """n classical RK4 steps of h (s) from t = 0 on every row of Y (M, 7), in place, with the
-        stage sums of :func:`lib.integrators.batch.steps` in their order. Returns (0, 0, 0), or
-        (1, t, row) where a stage's state exceeds ``blowup`` in magnitude, or (2, t, row) where a
-        step ends non-finite."""
-        if stamp < 0:
-            return 0, 0.0, 0
-        M = Y.shape[0]
-        K = np.empty((4, M, 7))
+    def run(Y, n, h, hA, c, b, hb, blowup, R, Th, p, q, fc, ac, taw, circle):
+        """n steps of h (s) of the explicit tableau (hA = h A, c, b, hb = h / b_den) from t = 0 on
+        every row of Y (M, 7), in place, with the stage sums of :func:`lib.integrators.batch.steps`
+        in their order (zero coefficients skipped). Returns (0, 0, 0), or (1, t, row) where a
+        stage's state exceeds ``blowup`` in magnitude, or (2, t, row) where a step ends non-finite."""
+        M, S = Y.shape[0], c.size
+        K = np.empty((S, M, 7))
         yi = np.empty((M, 7))
-        for k in range(n):
+        for k in range(n if stamp >= 0 else 0):
             t = k * h
-            for i in range(4):
-                a = 0.0 if i == 0 else (h * 1.0 if i == 3 else h * 0.5)
+            for i in range(S):
                 for r in range(M):
-                    for c in range(7):
-                        yi[r, c] = Y[r, c] if i == 0 else Y[r, c] + a * K[i - 1, r, c]
-                        if abs(yi[r, c]) > blowup:
-                            return 1, t + (0.0, 0.5, 0.5, 1.0)[i] * h, r
-                _rows_field(t + (0.0, 0.5, 0.5, 1.0)[i] * h, yi, K[i], R, Th, p, q, fc, ac, taw, circle)
-            hb = h / 6.0
+                    for col in range(7):
+                        v = Y[r, col]
+                        for j in range(i):
+                            if hA[i, j] != 0:
+                                v = v + hA[i, j] * K[j, r, col]
+                        if abs(v) > blowup:
+                            return 1, t + c[i] * h, r
+                        yi[r, col] = v
+                _rows_field(t + c[i] * h, yi, K[i], R, Th, p, q, fc, ac, taw, circle)
             for r in range(M):
-                for c in range(7):
-                    Y[r, c] = Y[r, c] + hb * (((1.0 * K[0, r, c] + 2.0 * K[1, r, c]) + 2.0 * K[2, r, c])
-                                              + 1.0 * K[3, r, c])
-                    if not np.isfinite(Y[r, c]):
+                for col in range(7):
+                    acc = b[0] * K[0, r, col]
+                    for j in range(1, S):
+                        if b[j] != 0:
+                            acc = acc + b[j] * K[j, r, col]
+                    Y[r, col] = Y[r, col] + hb * acc
+                    if not np.isfinite(Y[r, col]):
                         return 2, (k + 1) * h, r
         return 0, 0.0, 0
     return run
 
 
-_rk4_rows = _make_rk4_rows(source_stamp(Path(full_loop.__file__)))
+_rows_steps = _make_rows_steps(source_stamp(Path(full_loop.__file__)))
 
 
 def _percussion_period_end(body: Body, gains: Gains, ref, limits: Limits) -> Callable:
-    """``period_end(x, T, steps)`` of the law for P under ``limits``: the RK4 steps that
-    :class:`lib.optimal.loop.FlowMap` takes with ``steps`` a period (the largest step <= T / steps
-    that divides T), compiled on the field of :func:`lib.percussion.full_loop.limited_field`; a
-    state beyond :data:`lib.optimal.loop.BLOWUP` or not finite raises ``SimulationError`` naming
-    the time, as the numpy steps do."""
+    """``period_end(x, n, h, blowup)`` of the law for P under ``limits``
+    (:class:`lib.optimal.loop.FlowMap`): the classical RK4 (:data:`lib.integrators.batch.RK4`)
+    compiled on the field of :func:`lib.percussion.full_loop.limited_field`."""
     args = _limited_args(body, gains, ref, limits, ANTI_WINDUP_TIME)
 
-    def period_end(x, T, steps):
-        n = int(np.ceil(T / (T / steps)))
+    def period_end(x, n, h, blowup):
         Y = np.array(x, dtype=float, order="C").reshape(-1, 7)
-        code, t, row = _rk4_rows(Y, n, T / n, BLOWUP, *args)
-        if code == 1:
-            raise SimulationError(f"the closed loop blew up: a state beyond {BLOWUP:g} at t = {t:.6g} s")
-        if code == 2:
-            raise SimulationError(f"the closed loop blew up: batch integration became non-finite at t = {t:.6g} s "
-                                  f"for point {row}")
-        return Y.reshape(np.shape(x))
+        status = _rows_steps(Y, n, h, h * RK4.A, RK4.c, RK4.b, h / RK4.b_den, blowup, *args)
+        return (Y.reshape(np.shape(x)), *status)
     return period_end
 
 

@@ -25,7 +25,7 @@ from scipy.integrate import solve_ivp
 
 from ..dynamics import verdicts as dv
 from ..dynamics.sampled import sampled_extremes
-from ..integrators.batch import RK4, integrate
+from ..integrators.batch import RK4, fixed_steps, integrate, nonfinite_message
 from ..integrators.smooth import Integration, SimulationError
 from ..machinery import checks
 
@@ -48,16 +48,25 @@ LOOP_OPTIONS = dict(transient=24, history=12, max_period=4, candidate_tol=1e-3, 
 _INTEGER_OPTIONS = dict(transient=1, history=3, max_period=1, newton_iter=1, steps=0)
 
 
+def _beyond(t: float) -> str:
+    """What :func:`_fixed` says of a stage's state beyond :data:`BLOWUP` at t (s)."""
+    return f"a state beyond {BLOWUP:g} at t = {t:.6g} s"
+
+
+def _blew_up(what) -> SimulationError:
+    return SimulationError(f"the closed loop blew up: {what}")
+
+
 def _fixed(rates: Rates, x: np.ndarray, t0: float, t1: float, steps: int):
     """Classical RK4 with ``steps`` fixed steps from t0 to t1, every step recorded: (t, states (n, M, d))."""
     def f(t, y):
         if np.max(np.abs(y)) > BLOWUP:
-            raise FloatingPointError(f"a state beyond {BLOWUP:g} at t = {t:.6g} s")
+            raise FloatingPointError(_beyond(t))
         return rates(t, y)
     try:
         return integrate(f, x, t0, t1, (t1 - t0) / steps, RK4)
     except FloatingPointError as err:
-        raise SimulationError(f"the closed loop blew up: {err}") from None
+        raise _blew_up(err) from None
 
 
 def _integrate(rates: Rates, x: np.ndarray, t0: float, t1: float, rtol: float, atol: float, dense: bool = False):
@@ -81,8 +90,10 @@ class FlowMap:
     """The period map of a T-periodic field: ``advance(idx, x, k)`` integrates the rows x (M, d)
     over k periods each (adaptive DOP853, all rows at once), the heading (column ``turn_axis``)
     continuous. A :class:`lib.dynamics.verdicts.PeriodMap`; one field for every row (``idx`` unused).
-    With fixed ``steps``, ``period_end(x, T, steps)`` (optional) is a compiled run of the same RK4
-    steps to the period's end, used where no step is recorded (:meth:`end`)."""
+    With fixed ``steps``, ``period_end(x, n, h, blowup)`` (optional) is a compiled run of the same
+    RK4 steps, n of h (s) from t = 0, used where no step is recorded (:meth:`end`): it returns the
+    end (M, d) and a status (code, t, row), code 1 where a stage's state exceeds ``blowup`` and 2
+    where a step ends non-finite (0 otherwise), which :meth:`end` raises as :func:`_fixed` does."""
 
     def __init__(self, rates: Rates, period: float, *, turn_axis: int = 2, rtol: float = 1e-10,
                  atol: float = 1e-10, steps: int = 0, period_end: Callable | None = None):
@@ -91,9 +102,12 @@ class FlowMap:
 
     def end(self, x: np.ndarray) -> np.ndarray:
         """The rows x (M, d) at t = 0 after one period."""
-        if self.steps and self.period_end is not None:
-            return self.period_end(x, self.period, self.steps)
-        return self.one(x)[0]
+        if not (self.steps and self.period_end is not None):
+            return self.one(x)[0]
+        y, code, t, row = self.period_end(x, *fixed_steps(0.0, self.period, self.period / self.steps), BLOWUP)
+        if code:
+            raise _blew_up(_beyond(t) if code == 1 else nonfinite_message(t, row))
+        return y
 
     def one(self, x: np.ndarray, samples: int = 0):
         """One period from the rows x (M, d) at t = 0: the end (M, d) and, with ``samples`` > 0
@@ -217,7 +231,7 @@ def loop_verdict(rates: Rates, period: float, s0, *, reference_turns: int = 0, p
     if not callable(rates):
         raise TypeError(f"rates must be a callable (t, s) -> s', got {type(rates).__name__}")
     if period_end is not None and not callable(period_end):
-        raise TypeError(f"period_end must be None or a callable (x, T, steps) -> x, got {type(period_end).__name__}")
+        raise TypeError(f"period_end must be None or a callable (x, n, h, blowup), got {type(period_end).__name__}")
     period = checks.number("period", period, positive=True, unit="s")
     s0 = checks.array("s0", s0, ndim=1)
     reference_turns = checks.integer("reference_turns", reference_turns)
