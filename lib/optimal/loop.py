@@ -49,7 +49,7 @@ _INTEGER_OPTIONS = dict(transient=1, history=3, max_period=1, newton_iter=1, ste
 
 
 def _beyond(t: float) -> str:
-    """What :func:`_fixed` says of a stage's state beyond :data:`BLOWUP` at t (s)."""
+    """What ``_fixed`` says of a stage's state beyond :data:`BLOWUP` at t (s)."""
     return f"a state beyond {BLOWUP:g} at t = {t:.6g} s"
 
 
@@ -93,7 +93,7 @@ class FlowMap:
     With fixed ``steps``, ``period_end(x, n, h, blowup)`` (optional) is a compiled run of the same
     RK4 steps, n of h (s) from t = 0, used where no step is recorded (:meth:`end`): it returns the
     end (M, d) and a status (code, t, row), code 1 where a stage's state exceeds ``blowup`` and 2
-    where a step ends non-finite (0 otherwise), which :meth:`end` raises as :func:`_fixed` does."""
+    where a step ends non-finite (0 otherwise), which :meth:`end` raises as ``_fixed`` does."""
 
     def __init__(self, rates: Rates, period: float, *, turn_axis: int = 2, rtol: float = 1e-10,
                  atol: float = 1e-10, steps: int = 0, period_end: Callable | None = None):
