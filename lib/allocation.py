@@ -312,8 +312,8 @@ def _limited(tau, phi, body: Body, sw, limits: Limits):
     u_star, G, r, bb = _ls_kernel(tau, phi, body, sw)
     fmax, bmax = (d if x is None else float(x) for x, d in ((limits.force, np.inf), (limits.angle, np.pi)))
     shape = np.broadcast_shapes(u_star.shape[:-1], G.shape[:-2], r.shape[:-1], bb.shape)
-    rows = [np.ascontiguousarray(np.broadcast_to(x, shape + x.shape[x.ndim - k:]).reshape((-1,) + x.shape[x.ndim - k:]),
-                                 dtype=float) for x, k in ((u_star, 1), (G, 2), (r, 1), (bb, 0))]
+    rows = [np.require(np.broadcast_to(x, shape + x.shape[x.ndim - k:]).reshape(-1, *x.shape[x.ndim - k:]), float, "CW")
+            for x, k in ((u_star, 1), (G, 2), (r, 1), (bb, 0))]  # writable: a read-only array is another numba type
     F, beta = _limited_rows(*rows, fmax, bmax, 129, 5)
     return F.reshape(shape), beta.reshape(shape)
 

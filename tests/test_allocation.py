@@ -156,6 +156,20 @@ def test_limited_allocation_beats_projection_and_reduces_without_limits():
     np.testing.assert_allclose(np.angle(np.exp(1j * (beta - b0))), 0.0, rtol=0, atol=1e-14)  # exact: two closed forms of (25)-(26); measured 1.3e-15
 
 
+def test_a_broadcast_problem_compiles_no_second_limited_kernel():
+    """One tau for many headings is broadcast row by row, a read-only array, which numba types
+    apart from a writable one and would compile into a second kernel of the same arithmetic. The
+    rows reach the kernel writable: it keeps its one signature."""
+    from lib.allocation import _limited_rows
+
+    tau, phi = np.array([1.0, -2.0, 0.5]), np.linspace(-3.0, 3.0, 5)
+    each = allocate_limited(np.tile(tau, (5, 1)), phi, Body(), (1.0, 1.0, 0.5), 2.0, 0.5)
+    compiled = len(_limited_rows.signatures)
+    shared = allocate_limited(tau, phi, Body(), (1.0, 1.0, 0.5), 2.0, 0.5)
+    assert len(_limited_rows.signatures) == compiled
+    assert all(np.array_equal(x, y) for x, y in zip(shared, each))  # exact: the same rows, the same kernel
+
+
 @pytest.mark.parametrize("kw, msg", [({"force_limit": -1.0}, "force_limit"), ({"angle_limit": 4.0}, "angle_limit"),
                                      ({"weights": (0.0, 0.0, 0.0)}, "weights")])
 def test_limited_allocation_rejects_bad_input(kw, msg):

@@ -267,6 +267,19 @@ def test_compiled_switched_runs_match_the_event_located_reference(deg, cap):
     assert abs(runs.t_sliding[0] - seg.t_sliding) < 2.5e-8  # measured 2.6e-9
 
 
+def test_a_read_only_start_compiles_no_second_kernel():
+    """One start for one run is broadcast to (1, 6) (as limit_verdicts' chunks of one run are), a
+    read-only array, which numba types apart from a writable one and would compile into a second
+    kernel of the same arithmetic (seconds on a fresh clone). The run reaches the kernel
+    writable: the kernel keeps its one signature."""
+    ref, b = T.eight(), math.radians(30.0)
+    two = L.switched_runs(Body(), Gains(), ref, [b, b], s0=np.tile(S0, (2, 1)), n_periods=1)  # writable
+    compiled = len(switched_compiled._run.signatures)
+    one = L.switched_runs(Body(), Gains(), ref, b, s0=S0, n_periods=1)
+    assert len(switched_compiled._run.signatures) == compiled
+    assert np.array_equal(one.states[0], two.states[0])  # exact: each run is computed alone
+
+
 def test_compiled_switched_runs_are_fourth_order_or_better_in_the_step():
     # halving the step on a run with crossings and a slide (45 deg): the error against a
     # run with 4x the steps falls by at least 2^4 (an 8th-order method that loses order at

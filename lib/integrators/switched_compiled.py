@@ -272,14 +272,16 @@ def run_periods(P: np.ndarray, angle_limits: np.ndarray, force_limits: np.ndarra
     if dense_output is None:
         AX, CX, D = np.zeros((3, 16)), np.zeros(3), np.zeros((4, 16))
     else:
-        AX, CX, D = (np.ascontiguousarray(x, float) for x in dense_output)
+        AX, CX, D = (np.asarray(x, float) for x in dense_output)
         if c.size != 12 or AX.shape != (3, 16) or CX.shape != (3,) or D.shape != (4, 16):
             raise ValueError("dense_output is DOP853's (12 stages): A_extra (3, 16), C_extra (3,), D (4, 16)")
-    _run(np.ascontiguousarray(P, float), np.ascontiguousarray(angle_limits, float),
-         np.ascontiguousarray(force_limits, float), np.ascontiguousarray(S0, float), int(n_periods),
-         int(steps_per_period), float(period), float(t0), int(lyapunov_from), float(d0),
-         np.ascontiguousarray(A, float), np.ascontiguousarray(b, float), np.ascontiguousarray(c, float),
-         dense_output is not None, AX, CX, D, sections, modes, logs, stats, rec_from, rec_every, samples)
+    # C-contiguous and writable (copied if need be): numba compiles a read-only array (a
+    # broadcast, a view of one) as another type, a second kernel of the same arithmetic
+    P, bmax, fmax, S0, A, b, c, AX, CX, D = (np.require(x, float, "CW") for x in (
+        P, angle_limits, force_limits, S0, A, b, c, AX, CX, D))
+    _run(P, bmax, fmax, S0, int(n_periods), int(steps_per_period), float(period), float(t0), int(lyapunov_from),
+         float(d0), A, b, c, dense_output is not None, AX, CX, D, sections, modes, logs, stats, rec_from, rec_every,
+         samples)
     return sections, modes, logs, stats, (None if record is None else samples)
 
 
