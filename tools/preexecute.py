@@ -46,11 +46,11 @@ LAST = ("errata", "report", "intro")
 #: instead of 127). Each point of a parallel loop is computed alone, so the results do not
 #: depend on the threads (``make test-portable`` runs the tests on one).
 KERNEL_ENV = {"OPENBLAS_NUM_THREADS": "1"}
-#: a page's CPU time (s), measured (the log of ``make book`` from an empty ``_build``, 2026-11-27,
-#: after Chapter 8's mesh study and compiled law for P), to start the longest first (unknown pages first of all)
-COST = {"chapters/04_limits": 117, "chapters/05_stability": 91, "chapters/08_optimal": 31,
-        "chapters/03_tracking": 17, "chapters/06_allocation": 14, "chapters/07_percussion": 13,
-        "chapters/02_controllability": 10, "chapters/01_model": 3, "methods": 2}
+#: a page's CPU time (s), measured (the log of ``make book`` from an empty ``_build``, numba's
+#: kernels compiled, 2026-11-27), to start the longest first (unknown pages first of all)
+COST = {"chapters/04_limits": 117, "chapters/05_stability": 91, "chapters/08_optimal": 32,
+        "chapters/03_tracking": 17, "chapters/06_allocation": 15, "chapters/07_percussion": 13,
+        "chapters/02_controllability": 10, "chapters/01_model": 3, "methods": 1}
 
 
 def kernel_env(jobs: int, cores: int | None = None) -> dict:
