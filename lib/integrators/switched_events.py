@@ -30,8 +30,12 @@ No state is interpolated: every landing state comes from a real step from the st
 from __future__ import annotations
 
 import numba
+import numpy as np
 
 from .switched_field import N_EVENTS, _field
+
+# the constants these kernels pass to one another are typed values (np.int64, np.bool_), not
+# literals, which numba would compile into a copy of the callee each (switched_compiled: _LITERALS)
 
 __all__ = ["T_TOL"]
 
@@ -252,7 +256,7 @@ def _dense_landing(P, lim, mode, t, s, dt, first, A, b, c, K, ys, y1, y2, g0, g1
     ev = first
     # a rough estimate on the step's cubic Hermite interpolant (the step straddles the event,
     # so no interpolant of it is accurate there), then a real step to just before it
-    guess = _hermite_root(P, lim, mode, t, dt, s, K[0], y1, ys, g0, ev, yh, fh, gh, 16)
+    guess = _hermite_root(P, lim, mode, t, dt, s, K[0], y1, ys, g0, ev, yh, fh, gh, np.int64(16))
     ta, tb = guess - _MARGIN * dt, min(guess + _MARGIN * dt, dt)
     if not (0.0 < ta and guess < dt):
         stats[6] += 1
@@ -276,8 +280,8 @@ def _dense_landing(P, lim, mode, t, s, dt, first, A, b, c, K, ys, y1, y2, g0, g1
     if ev < 0:  # the continuation does not reach the event by tb
         stats[6] += 1
         return ta, dt, ga[first], g2[first], first, False
-    lo, hi, ev = _illinois(P, lim, mode, t, s, ta, tb, ga[ev], gh[ev], ev, _DENSE_TOL, True, F, ta, A, b, c, K,
-                           ys, yh, gh, y2, g2, g0, stats)
+    lo, hi, ev = _illinois(P, lim, mode, t, s, ta, tb, ga[ev], gh[ev], ev, _DENSE_TOL, np.bool_(True), F, ta, A, b,
+                           c, K, ys, yh, gh, y2, g2, g0, stats)
     # the event function's slope there, on the continuation over 1e-6 of the step
     th, tq = hi, hi - 1e-6 * dt
     _dense_state(F, s, th / ta, yh)
@@ -335,7 +339,7 @@ def _locate(P, lim, mode, t, s, dt, first, A, b, c, K, ys, y1, y2, g0, g1, g2, y
         _copy(y1, g1, y2, g2)
         # first on the step's cubic Hermite interpolant (one field evaluation per try), then
         # two real steps a little before and after its root narrow the bracket cheaply
-        guess = _hermite_root(P, lim, mode, t, dt, s, K[0], y1, ys, g0, ev, yh, fh, gh, 34)
+        guess = _hermite_root(P, lim, mode, t, dt, s, K[0], y1, ys, g0, ev, yh, fh, gh, np.int64(34))
         if 0.0 < guess < dt:
             for th in (guess - _MARGIN * dt, guess + _MARGIN * dt):
                 if not lo < th < hi:
@@ -353,6 +357,6 @@ def _locate(P, lim, mode, t, s, dt, first, A, b, c, K, ys, y1, y2, g0, g1, g2, y
                     break
                 lo = th
                 glo = g1[ev]
-    lo, hi, ev = _illinois(P, lim, mode, t, s, lo, hi, glo, ghi, ev, T_TOL, False, F, dt, A, b, c, K, ys, y1, g1,
-                           y2, g2, g0, stats)
+    lo, hi, ev = _illinois(P, lim, mode, t, s, lo, hi, glo, ghi, ev, T_TOL, np.bool_(False), F, dt, A, b, c, K, ys,
+                           y1, g1, y2, g2, g0, stats)
     return hi
