@@ -210,7 +210,7 @@ def _paper_rows(t, Y, eight, R, Th, model, k, plant, fmax, bmax, out):  # pragma
     """s' of the rows of Y (M, 6) under the paper's law: the path at t, (23) with the model's m and
     c (``model``) and k = (kp_x, kp_y, kv_x, kv_y), (25)-(26) under the cap ``fmax`` and the angle
     limit ``bmax`` (``Limits.apply``), (2)-(4) of the plant (m, I, c, c_phi, a)."""
-    xd, yd, _, vxd, vyd, _, axd, ayd, _ = _path(t, R, Th, eight, False)
+    xd, yd, _, vxd, vyd, _, axd, ayd, _ = _path(t, R, Th, eight, np.bool_(False))  # typed, not a literal
     mm, cm = model[0], model[1]
     m, I, c_lin, c_phi, a = plant[0], plant[1], plant[2], plant[3], plant[4]
     for q in range(Y.shape[0]):
@@ -260,7 +260,7 @@ def _problem_rows(t, Y, p, sw, R, Th, eight, u, G, r, bb, regular, A, b):  # pra
     ``lib.allocation._ls_kernel`` states them. p = (m, I, a, c, c_phi, kp (3), kv (3)); sw the
     square roots of the weights."""
     m, I, a, c, cphi = p[0], p[1], p[2], p[3], p[4]
-    zd0, zd1, zd2, vd0, vd1, vd2, ad0, ad1, ad2 = _path(t, R, Th, eight, True)
+    zd0, zd1, zd2, vd0, vd1, vd2, ad0, ad1, ad2 = _path(t, R, Th, eight, np.bool_(True))
     for q in range(Y.shape[0]):
         y = Y[q]
         b0 = sw[0] * _demand(m, c, p[5], p[8], zd0 - y[0], vd0, ad0, y[3])

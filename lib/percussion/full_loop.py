@@ -61,7 +61,7 @@ _MINIMA = dict(chunk=3, max_periods=3, max_period=1, newton_iter=1, min_steps=8)
 
 
 @numba.njit(cache=True)
-def _field(t, y, out, R, Th, p, q, fc=math.inf, ac=math.pi, taw=0.0, circle=False):
+def _field(t, y, out, R, Th, p, q, fc, ac, taw, circle):
     """The 7 states' rates (out, in place) and the applied F (N) on the eight (28) at (R, Th) or the circle
     (27); model p = (m, I, a, c, c_phi, s_P, eps, k2x, k1x, k0x, k2y, k1y, k0y), plant q = (m, I, a, c, c_phi);
     cap ``fc`` (N), angle limit ``ac`` (rad), T_aw ``taw`` (s, 0: none) of law.closed_loop_rates."""
@@ -150,7 +150,7 @@ def _periods(x, R, Th, steps, p, pl, k, fmax, emax):
     """Advance each row of x (M, 7) in place by k[q] periods of the eight by RK4 with steps[q]
     steps a period; fmax[q] the largest F (N) and emax[q] the largest distance of the model's P
     from the path (m) seen at a step's start (running)."""
-    d = 7
+    d, free = 7, (math.inf, math.pi, 0.0, np.bool_(False))  # no limit, no anti-windup, the eight (typed)
     k1, k2, k3, k4, yy = np.empty(d), np.empty(d), np.empty(d), np.empty(d), np.empty(d)
     for q in range(x.shape[0]):
         n = steps[q]
@@ -158,7 +158,7 @@ def _periods(x, R, Th, steps, p, pl, k, fmax, emax):
         y = x[q]
         for j in range(k[q] * n):
             t = (j % n) * h
-            f = _field(t, y, k1, R[q], Th[q], p, pl)
+            f = _field(t, y, k1, R[q], Th[q], p, pl, *free)
             if f > fmax[q] or f != f:
                 fmax[q] = f
             ex = y[0] + p[5] * math.cos(y[2]) - 0.5 * R[q] * math.sin(2 * Th[q] * t)
@@ -166,13 +166,13 @@ def _periods(x, R, Th, steps, p, pl, k, fmax, emax):
             emax[q] = max(emax[q], math.hypot(ex, ey))
             for i in range(d):
                 yy[i] = y[i] + 0.5 * h * k1[i]
-            _field(t + 0.5 * h, yy, k2, R[q], Th[q], p, pl)
+            _field(t + 0.5 * h, yy, k2, R[q], Th[q], p, pl, *free)
             for i in range(d):
                 yy[i] = y[i] + 0.5 * h * k2[i]
-            _field(t + 0.5 * h, yy, k3, R[q], Th[q], p, pl)
+            _field(t + 0.5 * h, yy, k3, R[q], Th[q], p, pl, *free)
             for i in range(d):
                 yy[i] = y[i] + h * k3[i]
-            _field(t + h, yy, k4, R[q], Th[q], p, pl)
+            _field(t + h, yy, k4, R[q], Th[q], p, pl, *free)
             for i in range(d):
                 y[i] += h / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i])
             if not math.isfinite(y[2]) or abs(y[6]) > 1e12:
@@ -243,9 +243,9 @@ def compiled_rates(body: Body, gains: Gains, R: float, Theta: float, t: float, y
     F : float
         The force magnitude (N).
     """
-    out = np.empty(7)
-    law = _params(body if model is None else model, gains)
-    F = _field(float(t), np.asarray(y, dtype=float).copy(), out, float(R), float(Theta), law, _plant(body))
+    out, law = np.empty(7), _params(body if model is None else model, gains)
+    F = _field(float(t), np.asarray(y, dtype=float).copy(), out, float(R), float(Theta), law, _plant(body),
+               math.inf, math.pi, 0.0, False)
     return out, float(F)
 
 
