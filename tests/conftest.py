@@ -108,6 +108,23 @@ def perturb(request):
     return (lambda x: np.asarray(x, dtype=float)) if rel == 0 else (lambda x: perturbed(x, rel))
 
 
+@pytest.fixture
+def fresh_signatures(tmp_path):
+    """``count(code, modules)``: runs ``code`` in a new interpreter on an empty numba cache (as a
+    fresh clone's first run compiles) and returns, for every compiled function of ``modules``,
+    how many signatures numba compiled for it: {"module name": n}."""
+    def count(code: str, modules: tuple[str, ...]) -> dict[str, int]:
+        report = ("\nimport importlib\nfor _m in %r:\n    for _n, _f in vars(importlib.import_module(_m)).items():\n"
+                  "        if hasattr(_f, 'signatures'):\n            print('signatures', _m, _n, len(_f.signatures))\n"
+                  % (tuple(modules),))
+        env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), NUMBA_NUM_THREADS="1")
+        out = subprocess.run([sys.executable, "-c", code + report], env=env, capture_output=True, text=True,
+                             check=True).stdout
+        rows = [line.split() for line in out.splitlines() if line.startswith("signatures ")]
+        return {f"{m} {n}": int(k) for _, m, n, k in rows}
+    return count
+
+
 def pytest_collection_modifyitems(config, items):
     """Mark every test that uses the robustness mode, so that ``pytest -m robustness`` runs them alone."""
     for item in items:

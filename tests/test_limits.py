@@ -1,5 +1,4 @@
 import math
-import os
 
 import numpy as np
 import pytest
@@ -281,36 +280,26 @@ def test_a_read_only_start_compiles_no_second_kernel():
     assert np.array_equal(one.states[0], two.states[0])  # exact: each run is computed alone
 
 
-_ONE_COMPILATION = """
-import math, numpy as np
+_SWITCHED_RUNS = """
+import numpy as np
 from lib.limits import runs
 from lib import trajectories
 from lib.params import Body, Gains
-from lib.integrators import switched_compiled, switched_events, switched_field
 b = np.radians([30.0, 60.0])
 for locator in ("dense", "bracket"):
     runs.switched_runs(Body(), Gains(), trajectories.eight(), b, [np.inf, 4.0], n_periods=3, lyapunov_from=1,
                        locator=locator, record=(1, 4))
 runs.switched_runs(Body(), Gains(), trajectories.eight(), b[0], s0=runs._start_states(None, 1)[0], n_periods=2)
-for mod in (switched_compiled, switched_events, switched_field):
-    for name, f in vars(mod).items():
-        if hasattr(f, "signatures"):
-            print(mod.__name__, name, len(f.signatures))
 """
 
 
-def test_the_switched_kernels_compile_once_each_on_a_fresh_clone(tmp_path):
+def test_the_switched_kernels_compile_once_each_on_a_fresh_clone(fresh_signatures):
     """On an empty numba cache (a fresh clone), every compiled function of the switched integrator
     is compiled for one signature: no constant passed between them as a literal and no read-only
     start makes numba compile a second copy of the same arithmetic (switched_compiled: _LITERALS)."""
-    import subprocess
-    import sys
-
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), NUMBA_NUM_THREADS="1")
-    out = subprocess.run([sys.executable, "-c", _ONE_COMPILATION], env=env, capture_output=True, text=True,
-                         check=True).stdout.split("\n")
-    counts = {" ".join(line.split()[:2]): int(line.split()[2]) for line in out if line.strip()}
-    assert counts and counts["lib.integrators.switched_compiled _run"] == 1
+    counts = fresh_signatures(_SWITCHED_RUNS, ("lib.integrators.switched_compiled", "lib.integrators.switched_events",
+                                               "lib.integrators.switched_field"))
+    assert counts["lib.integrators.switched_compiled _run"] == 1
     assert {k: n for k, n in counts.items() if n > 1} == {}
 
 

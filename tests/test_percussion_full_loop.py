@@ -234,9 +234,10 @@ def test_p_starts_off_the_path_by_the_paper_start_and_s_p():
     np.testing.assert_allclose(got, want, rtol=1e-12)   # exact: closed forms, to rounding
 
 
-_ONE_COMPILATION = """
+
+_LOOPS = """
 import math, numpy as np
-from lib import allocation, closed_loop, trajectories
+from lib import closed_loop, trajectories
 from lib.allocation import Limits
 from lib.params import Body, Gains
 from lib.percussion import full_loop
@@ -247,25 +248,14 @@ full_loop.compiled_rates(body, gains, 2.0, math.pi / 4, 0.3, np.full(7, 0.1))
 full_loop.limited_field(body, gains, ref, lim, 2.0)(0.3, np.full((3, 7), 0.1))
 closed_loop.paper_rates(body, gains, ref, limits=lim)(0.3, Y[0])
 closed_loop.limited_weighted_field(body, gains, ref, lim, (1.0, 1.0, 0.5))(0.3, Y)
-for mod in (allocation, closed_loop, full_loop):
-    for name, f in vars(mod).items():
-        if hasattr(f, "signatures"):
-            print(mod.__name__, name, len(f.signatures))
 """
 
 
-def test_the_loops_kernels_compile_once_each_on_a_fresh_clone(tmp_path):
+def test_the_loops_kernels_compile_once_each_on_a_fresh_clone(fresh_signatures):
     """On an empty numba cache (a fresh clone), the compiled closed loops (the paper's law and the
     weighted law under limits, the law for P's full loop, free and limited) compile each function
     for one signature: no flag passed as a literal, no default omitted by one caller and given by
     another, makes numba compile a second copy of the same arithmetic."""
-    import os
-    import subprocess
-    import sys
-
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), NUMBA_NUM_THREADS="1")
-    out = subprocess.run([sys.executable, "-c", _ONE_COMPILATION], env=env, capture_output=True, text=True,
-                         check=True).stdout.split("\n")
-    counts = {" ".join(line.split()[:2]): int(line.split()[2]) for line in out if line.strip()}
+    counts = fresh_signatures(_LOOPS, ("lib.allocation", "lib.closed_loop", "lib.percussion.full_loop"))
     assert counts["lib.closed_loop _path"] == 1 and counts["lib.percussion.full_loop _field"] == 1
     assert {k: n for k, n in counts.items() if n > 1} == {}
