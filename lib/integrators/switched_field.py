@@ -34,7 +34,8 @@ def _kin(P, t):
         c, sn = math.cos(s), math.sin(s)
         return (R * c, R * sn, -R * th * sn, R * th * c, -R * th**2 * c, -R * th**2 * sn,
                 R * th**3 * sn, -R * th**3 * c)
-    c1, s1, c2, s2 = math.cos(s), math.sin(s), math.cos(2 * s), math.sin(2 * s)
+    c1, s1 = math.cos(s), math.sin(s)
+    c2, s2 = (c1 - s1) * (c1 + s1), 2 * s1 * c1  # cos 2s, sin 2s: one sincos, not two
     return (0.5 * R * s2, R * s1, R * th * c2, R * th * c1, -2 * R * th**2 * s2, -R * th**2 * s1,
             -4 * R * th**3 * c2, -R * th**3 * c1)
 
@@ -51,7 +52,7 @@ def _field(P, lim, mode, t, s, out, g):
     ty = m * ayd + cc * vy + P[_KVY] * (vyd - vy) + P[_KPY] * (yd - y)
     c, sn = math.cos(phi), math.sin(phi)
     lat, lon = ty * c - tx * sn, tx * c + ty * sn
-    tn = math.hypot(tx, ty)
+    tn = math.sqrt(tx * tx + ty * ty)
     F = min(tn, fmax)
     ksl = P[_KSLIDE]
     # the clip's edges and the cap: kinks of the smooth fields
