@@ -10,9 +10,10 @@ import pytest
 from lib import trajectories
 from lib.allocation import Limits
 from lib.integrators.smooth import SimulationError
+from lib.limits.runs import switched_runs
 from lib.optimal import compare, study
 from lib.optimal.loop import BLOWUP, FlowMap
-from lib.params import Body, Gains
+from lib.params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from lib.tracking.runs import force_cap_sweep
 
 BODY, GAINS = Body(), Gains()
@@ -28,6 +29,28 @@ def test_the_paper_law_under_the_cap_is_periodic_and_measures_as_the_cap_sweep()
     assert row["max_error"] == pytest.approx(float(sweep.pos_err_max.iloc[0]), abs=2e-3)
     assert row["F_peak"] == 4.0                      # exact: the applied force is clipped at the cap
     assert 0.0 < row["rms_error"] < row["max_error"]
+
+
+def test_a_chaotic_row_of_the_paper_law_carries_the_standard_error_of_its_rms():
+    """Without an orbit the paper's law is measured on one chaotic run; the next PAPER_MEASURED
+    periods of the same run, another stretch of the same attractor, give its RMS again within
+    the two stretches' combined standard errors."""
+    ref = trajectories.eight(2.0, math.pi / 4)
+    chaotic, periodic = compare.paper_rows(BODY, GAINS, ref, [(30, None), (None, 4.0)])
+    assert chaotic["regime"] == "chaotic" and periodic["regime"] == "periodic"
+    assert math.isnan(periodic["rms_stderr"])      # exact: an orbit's period has no sampling error
+    se = chaotic["rms_stderr"]
+    assert 0.0 < se < 0.1 * chaotic["rms_error"]  # measured: 4 % of the RMS over 100 periods
+    H, M = compare.PAPER_HORIZON, compare.PAPER_MEASURED
+    run = switched_runs(BODY, GAINS, ref, math.radians(30), None, s0=np.concatenate([PAPER_Z0, PAPER_DZ0]),
+                        n_periods=H + M, samples_per_period=200)
+    m = run.t >= H * ref.period - 1e-9
+    t, st = run.t[m][:-1], run.states[0, m][:-1]
+    assert t.size == 200 * M
+    later = math.sqrt(np.mean(np.sum((st[:, :2] - ref.z(t)[:, :2]) ** 2, axis=1)))
+    # reason: 5 combined standard errors; the batch means' own estimate of it varies by about 10 %
+    # over 50 blocks and an intermittent stretch fattens the tails (measured up to 2.3 over 20-45 deg)
+    assert abs(later - chaotic["rms_error"]) < 5 * math.sqrt(2) * se
 
 
 @pytest.mark.parametrize("angle, cap", [(None, None), (None, 4.0), (30, None), (30, 4.0)])
@@ -89,6 +112,11 @@ def test_the_error_table_has_a_row_a_setting_and_says_where_a_run_diverged_or_no
     assert t.loc["4 N", "paper's law"] == "0.4 / 0.2"
     assert t.loc["30 deg", "weighted (Ch. 6)"] == "diverges"
     assert t.loc["30 deg", "bound"] == "-" and t.loc["4 N", "bound"] == "0.05 / 0.02"
+    rows = _rows().assign(rms_stderr=np.nan)
+    rows.loc[(rows.law == "paper") & (rows.setting == "30 deg"), "rms_stderr"] = 0.0123
+    t = compare.error_table(rows)
+    assert t.loc["30 deg", "paper's law"] == "0.4 / 0.2 ± 0.01"     # the RMS's error, one digit
+    assert t.loc["4 N", "paper's law"] == "0.4 / 0.2"                # NaN: no error shown
     r = compare.regime_table(_rows())
     assert "bound" not in r.columns and (r == "periodic").all().all()
 

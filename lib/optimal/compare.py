@@ -30,6 +30,7 @@ from ..limits.runs import switched_runs
 from ..limits.verdicts import limit_verdicts
 from ..machinery import checks
 from ..machinery.cache import source_stamp
+from ..dynamics.statistics import block_statistics
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from ..percussion import full_loop
 from ..percussion.full_loop import _limited_args, _rows_field, limited_field
@@ -42,7 +43,15 @@ from .tracker import periodic_lqr, track_motion
 from .verdict import basin, motion_verdict
 
 __all__ = ["LAWS", "LawLoop", "law_loop", "law_row", "paper_rows", "side_by_side", "WEIGHTS", "THRUST0",
-           "LAW_OPTIONS", "LAW_STEPS", "limits_study", "LAW_NAMES", "error_table", "regime_table", "tracker_table"]
+           "LAW_OPTIONS", "LAW_STEPS", "PAPER_HORIZON", "PAPER_MEASURED", "RMS_BLOCK", "limits_study", "LAW_NAMES",
+           "error_table", "regime_table", "tracker_table"]
+
+#: periods the paper's law runs from the paper's start where it reaches no orbit (:func:`paper_rows`)
+PAPER_HORIZON = 120
+#: the last periods of that run measured
+PAPER_MEASURED = 100
+#: periods a block of the batch means behind the standard error of that run's RMS distance
+RMS_BLOCK = 2
 
 #: the laws of the table, in its order
 LAWS = ("paper", "weighted", "percussion", "optimal")
@@ -220,12 +229,16 @@ def law_row(body: Body, gains: Gains, ref, law: str, limits: Limits, *, measure_
     return dict(regime=v.regime, reason=v.reason, floquet=v.floquet, **meas)
 
 
-def paper_rows(body: Body, gains: Gains, ref, settings=SETTINGS, *, horizon: int = 40, measured: int = 20) -> list:
+def paper_rows(body: Body, gains: Gains, ref, settings=SETTINGS, *, horizon: int = PAPER_HORIZON,
+               measured: int = PAPER_MEASURED) -> list:
     """The paper's law at each setting, decided by Chapter 4's procedure
     (:func:`lib.limits.verdicts.limit_verdicts`, the compiled switched loop, which also decides
     chaos) and measured on the same integrator (:func:`lib.limits.runs.switched_runs`, 200 samples
     a period): over one period of its orbit, or, without one, over the last ``measured`` of
-    ``horizon`` periods from the paper's start.
+    ``horizon`` periods from the paper's start. Without an orbit the RMS distance also gets
+    its standard error (``rms_stderr``, m; NaN with an orbit): the batch means of the
+    per-period mean squares in blocks of :data:`RMS_BLOCK` periods
+    (:func:`lib.dynamics.statistics.block_statistics`), carried to the RMS by its derivative.
 
     Parameters
     ----------
@@ -241,7 +254,7 @@ def paper_rows(body: Body, gains: Gains, ref, settings=SETTINGS, *, horizon: int
     Returns
     -------
     list of dict
-        One per setting: regime, reason, floquet and the measures.
+        One per setting: regime, reason, floquet, the measures and ``rms_stderr``.
     """
     angles = np.array([math.pi if a is None else math.radians(a) for a, _ in settings])
     caps = np.array([np.inf if c is None else c for _, c in settings])
@@ -259,7 +272,12 @@ def paper_rows(body: Body, gains: Gains, ref, settings=SETTINGS, *, horizon: int
                            angle_limit=angles[j])
         meas = steady_measures(t, st, F, beta, ref.z(t), F_cap=None if np.isinf(caps[j]) else caps[j],
                                beta_max=angles[j])
-        rows.append(dict(regime=r.regime, reason=r.reason, floquet=r.floquet, **meas))
+        se = np.nan
+        if not has_orbit:  # equal samples a period, so the RMS is that of the per-period mean squares
+            d2 = np.sum((st[:, :2] - ref.z(t)[:, :2]) ** 2, axis=1).reshape(keep, -1).mean(axis=1)
+            ms, se_ms = block_statistics(d2[None, :], RMS_BLOCK)
+            se = float(se_ms[0] / (2 * np.sqrt(ms[0])))
+        rows.append(dict(regime=r.regime, reason=r.reason, floquet=r.floquet, rms_stderr=se, **meas))
     return rows
 
 
@@ -386,8 +404,9 @@ def _by_setting(table: pd.DataFrame, values: str, laws) -> pd.DataFrame:
 
 def error_table(table: pd.DataFrame) -> pd.DataFrame:
     """:func:`side_by_side`'s table as the page shows it: one row a setting, one column a law, each
-    cell "largest / RMS" distance (m, three significant digits), "diverges" where the run blew up
-    and "-" where there is no row (no bound without a cap).
+    cell "largest / RMS" distance (m, three significant digits; the RMS "± its standard error" where
+    the row has one, ``rms_stderr``), "diverges" where the run blew up and "-" where there is no
+    row (no bound without a cap).
 
     Parameters
     ----------
@@ -400,7 +419,10 @@ def error_table(table: pd.DataFrame) -> pd.DataFrame:
         Index the settings in the table's order; columns the laws' names.
     """
     def cell(r):
-        return "diverges" if not np.isfinite(r.max_error) else f"{r.max_error:.3g} / {r.rms_error:.3g}"
+        if not np.isfinite(r.max_error):
+            return "diverges"
+        se = r.get("rms_stderr", np.nan)
+        return f"{r.max_error:.3g} / {r.rms_error:.3g}" + (f" ± {se:.1g}" if np.isfinite(se) else "")
 
     return _by_setting(table.assign(v=table.apply(cell, axis=1)), "v", LAW_NAMES).fillna("-")
 

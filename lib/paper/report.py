@@ -299,7 +299,8 @@ def _check_chaos() -> Outcome:
     cha = free[free.regime == "chaotic"]
     ok = chaos.regime == "chaotic" and chaos.lyapunov > 6 * chaos.lyapunov_stderr and len(cha) > 0
     return Outcome(legend_status(ok), chaos.lyapunov,
-                   "largest Lyapunov exponent (1/s), angle limit 30 deg, no force cap, eight",
+                   f"largest Lyapunov exponent (1/s; standard error {chaos.lyapunov_stderr:.3f}), angle limit "
+                   "30 deg, no force cap, eight",
                    f"chaotic at {len(cha)} of {len(free)} angle limits from {SWEEP_DEG[0]} to {SWEEP_DEG[-1]} deg "
                    "without a cap (Chapter 4)")
 
