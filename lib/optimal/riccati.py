@@ -9,8 +9,9 @@ numpy versions' cost was their calls' overhead: the motion's state read from its
 (:meth:`lib.optimal.motion.PeriodicMotion.state`, :meth:`~lib.optimal.motion.PeriodicMotion.inputs`),
 the Jacobians of (2)-(4) (:func:`lib.optimal.tracker.jacobians`), -P' = A'P + PA - P B R^-1 B' P + Q,
 the gain K = R^-1 B' P(t) from P's cubic Hermite interpolant. Here the same formulas in their
-order, the products and the 2 x 2 solve by numba's BLAS and LAPACK calls: equal to the numpy
-right-hand sides to rounding (``tests/test_optimal_tracker.py``; bit for bit on this machine).
+order, the small products summed in order and the 2 x 2 solve by LU with partial pivoting
+written out (numba's BLAS and LAPACK calls took about 8 s to compile on a fresh clone): equal
+to the numpy right-hand sides to rounding (``tests/test_optimal_tracker.py``).
 
 Units: SI (s, m, rad, N).
 """
@@ -91,14 +92,44 @@ def _jacobians(x, f, b, body):  # pragma: no cover (compiled)
 
 
 @numba.njit(cache=True)
+def _square(p):  # pragma: no cover (compiled)
+    """The (6, 6) matrix of a flat (36,) one, row by row (a copy, where ``reshape`` would make
+    numba compile its shape checks and their messages)."""
+    P = np.empty((6, 6))
+    for i in range(6):
+        for j in range(6):
+            P[i, j] = p[6 * i + j]
+    return P
+
+
+@numba.njit(cache=True)
+def _mul(X, Y, tx, ty):  # pragma: no cover (compiled)
+    """X @ Y of small matrices, X transposed if ``tx``, Y if ``ty``: each entry summed over k in
+    order (BLAS calls would cost more to compile than the products take)."""
+    n, m = (X.shape[1], X.shape[0]) if tx else (X.shape[0], X.shape[1])
+    p = Y.shape[0] if ty else Y.shape[1]
+    Z = np.empty((n, p))
+    for i in range(n):
+        for j in range(p):
+            acc = 0.0
+            for k in range(m):
+                acc += (X[k, i] if tx else X[i, k]) * (Y[j, k] if ty else Y[k, j])
+            Z[i, j] = acc
+    return Z
+
+
+@numba.njit(cache=True)
 def _rhs(t, t_in, p, period, nodes, snap, turns, F, beta, basis, colloc, body, Rinv, Q, out):  # pragma: no cover
     """-P' at t for P = p (36,) into out (36,): the motion's state at t, its inputs at t_in."""
     A, B = _jac(t, t_in, period, nodes, snap, turns, F, beta, basis, colloc, body)
-    P = p.reshape(6, 6)
-    M = A.T @ P + P @ A - P @ B @ Rinv @ np.ascontiguousarray(B.T) @ P + Q
+    P = _square(p)
+    no, yes = np.bool_(False), np.bool_(True)  # typed, not literals: one compiled _mul
+    AtP, PA = _mul(A, P, yes, no), _mul(P, A, no, no)
+    S = _mul(_mul(_mul(P, B, no, no), Rinv, no, no), B, no, yes)     # ((P B) R^-1) B'
+    S = _mul(S, P, no, no)                                              # then P, as numpy associates
     for i in range(6):
         for j in range(6):
-            out[6 * i + j] = -M[i, j]
+            out[6 * i + j] = -((AtP[i, j] + PA[i, j]) - S[i, j] + Q[i, j])
 
 
 @numba.njit(cache=True)
@@ -108,7 +139,12 @@ def _closed_rhs(t, t_in, y, period, nodes, snap, turns, F, beta, basis, colloc, 
     interpolant of the grid's P, dP (``PeriodicLQR.riccati``, ``PeriodicLQR._gain``)."""
     A, B = _jac(t, t_in, period, nodes, snap, turns, F, beta, basis, colloc, body)
     K = _gain(t, period, B, R, grid, PG, dPG)
-    M = (A - B @ K) @ y.reshape(6, 6)
+    no = np.bool_(False)
+    BK = _mul(B, K, no, no)
+    for i in range(6):
+        for j in range(6):
+            BK[i, j] = A[i, j] - BK[i, j]
+    M = _mul(BK, _square(y), no, no)
     for i in range(6):
         for j in range(6):
             out[6 * i + j] = M[i, j]
@@ -117,15 +153,28 @@ def _closed_rhs(t, t_in, y, period, nodes, snap, turns, F, beta, basis, colloc, 
 @numba.njit(cache=True)
 def _gain(t, period, B, R, grid, PG, dPG):  # pragma: no cover (compiled)
     """K = R^-1 B' P(t) (2, 6), P(t) the cubic Hermite interpolant of the grid's P and dP
-    (``PeriodicLQR.riccati``, ``PeriodicLQR._gain``)."""
+    (``PeriodicLQR.riccati``, ``PeriodicLQR._gain``); the 2 x 2 solve by LU with partial pivoting,
+    as LAPACK's."""
     s = np.mod(t, period)
     n = grid.size
     k = min(max(np.searchsorted(grid, s, side="right") - 1, 0), n - 2)
     h = grid[k + 1] - grid[k]
     r = (s - grid[k]) / h
-    P = ((1 + 2 * r) * (1 - r) ** 2 * PG[k] + r * (1 - r) ** 2 * h * dPG[k, 0]
-         + r * r * (3 - 2 * r) * PG[k + 1] - r * r * (1 - r) * h * dPG[k, 1])
-    return np.linalg.solve(R, np.ascontiguousarray(B.T) @ P)
+    c0, c1 = (1 + 2 * r) * (1 - r) ** 2, r * (1 - r) ** 2 * h
+    c2, c3 = r * r * (3 - 2 * r), r * r * (1 - r) * h
+    P = np.empty((6, 6))
+    for i in range(6):
+        for j in range(6):
+            P[i, j] = c0 * PG[k, i, j] + c1 * dPG[k, 0, i, j] + c2 * PG[k + 1, i, j] - c3 * dPG[k, 1, i, j]
+    Y = _mul(B, P, np.bool_(True), np.bool_(False))
+    i0, i1 = (1, 0) if abs(R[1, 0]) > abs(R[0, 0]) else (0, 1)          # the pivot row first
+    l = R[i1, 0] / R[i0, 0]
+    u = R[i1, 1] - l * R[i0, 1]
+    K = np.empty((2, 6))
+    for j in range(6):
+        K[1, j] = (Y[i1, j] - l * Y[i0, j]) / u
+        K[0, j] = (Y[i0, j] - R[i0, 1] * K[1, j]) / R[i0, 0]
+    return K
 
 
 def _make_loop_rows(stamp: int):
