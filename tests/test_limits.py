@@ -315,7 +315,7 @@ def test_compiled_switched_runs_are_fourth_order_or_better_in_the_step():
 
 
 def test_limit_verdicts_at_30_and_45_degrees_hold_from_a_perturbed_start(perturb):
-    # Without a cap both angles are chaotic (compiled: 0.29 and 0.22 1/s, 15-19 SE above zero);
+    # Without a cap both angles are chaotic (compiled: 0.27 and 0.22 1/s, 15-17 SE above zero);
     # with the 4 N cap both are period 1 and attract (|mu| 0.45, 0.39), and the slow path
     # (SwitchedLoop, adaptive with event location) returns to the located orbit point after
     # one period to 1.5e-7.
@@ -337,7 +337,7 @@ def test_chaotic_exponent_at_30_degrees_agrees_with_a_long_independent_run():
     # The compiled exponent against the slow path: SwitchedLoop (adaptive DOP853 with event
     # location, rtol 1e-9) and the generic Benettin estimator over 24 periods after 16, at the
     # angle limit of 30 deg. The slow run's exponent is positive (measured 9.0 of its SE: positive
-    # with room on any machine) and within 4 joint SE of the compiled one (measured 1.5). (The
+    # with room on any machine) and within 4 joint SE of the compiled one (measured 0.9). (The
     # verdicts' robustness to the start is the test above. At 45 deg the exponent is only 2.9 SE
     # over such a run, too close to zero for a sign test on any machine; the flow and the
     # estimator compared are the same, and Chapter 4 checks that exponent's convergence.)
