@@ -25,12 +25,12 @@ import pandas as pd
 from ..allocation import Allocation, Limits, allocate
 from ..closed_loop import ClosedLoop, limited_weighted_field, reference_of
 from ..control import computed_torque
+from ..dynamics.statistics import block_statistics
 from ..integrators.batch import RK4
 from ..limits.runs import switched_runs
 from ..limits.verdicts import limit_verdicts
 from ..machinery import checks
 from ..machinery.cache import source_stamp
-from ..dynamics.statistics import block_statistics
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from ..percussion import full_loop
 from ..percussion.full_loop import _limited_args, _rows_field, limited_field
@@ -270,11 +270,12 @@ def paper_rows(body: Body, gains: Gains, ref, settings=SETTINGS, *, horizon: int
         tau = computed_torque(body, gains, ref, t, st[:, :3], st[:, 3:])
         F, beta = allocate(tau, st[:, 2], force_limit=None if np.isinf(caps[j]) else caps[j],
                            angle_limit=angles[j])
-        meas = steady_measures(t, st, F, beta, ref.z(t), F_cap=None if np.isinf(caps[j]) else caps[j],
+        path = ref.z(t)
+        meas = steady_measures(t, st, F, beta, path, F_cap=None if np.isinf(caps[j]) else caps[j],
                                beta_max=angles[j])
         se = np.nan
         if not has_orbit:  # equal samples a period, so the RMS is that of the per-period mean squares
-            d2 = np.sum((st[:, :2] - ref.z(t)[:, :2]) ** 2, axis=1).reshape(keep, -1).mean(axis=1)
+            d2 = np.sum((st[:, :2] - path[:, :2]) ** 2, axis=1).reshape(keep, -1).mean(axis=1)
             ms, se_ms = block_statistics(d2[None, :], RMS_BLOCK)
             se = float(se_ms[0] / (2 * np.sqrt(ms[0])))
         rows.append(dict(regime=r.regime, reason=r.reason, floquet=r.floquet, rms_stderr=se, **meas))

@@ -168,11 +168,11 @@ def _gain(t, period, B, R, grid, PG, dPG):  # pragma: no cover (compiled)
             P[i, j] = c0 * PG[k, i, j] + c1 * dPG[k, 0, i, j] + c2 * PG[k + 1, i, j] - c3 * dPG[k, 1, i, j]
     Y = _mul(B, P, np.bool_(True), np.bool_(False))
     i0, i1 = (1, 0) if abs(R[1, 0]) > abs(R[0, 0]) else (0, 1)          # the pivot row first
-    l = R[i1, 0] / R[i0, 0]
-    u = R[i1, 1] - l * R[i0, 1]
+    mult = R[i1, 0] / R[i0, 0]
+    u = R[i1, 1] - mult * R[i0, 1]
     K = np.empty((2, 6))
     for j in range(6):
-        K[1, j] = (Y[i1, j] - l * Y[i0, j]) / u
+        K[1, j] = (Y[i1, j] - mult * Y[i0, j]) / u
         K[0, j] = (Y[i0, j] - R[i0, 1] * K[1, j]) / R[i0, 0]
     return K
 
