@@ -292,15 +292,15 @@ def _angle_sweep(cap):
 
 
 def _check_chaos() -> Outcome:
-    # chaos from the angle limit alone: 30 deg without a cap, by more than 6 standard errors
+    # chaos from the angle limit alone: CHAOS_DEG (30) without a cap, by more than 6 standard errors
     # (measured 15-19), and every chaotic angle of the sweep by at least 3
     free = _angle_sweep(None)
-    chaos = free[free.angle_deg.round() == 30].iloc[0]
+    chaos = studies.chaos_row(free)
     cha = free[free.regime == "chaotic"]
     ok = chaos.regime == "chaotic" and chaos.lyapunov > 6 * chaos.lyapunov_stderr and len(cha) > 0
     return Outcome(legend_status(ok), chaos.lyapunov,
                    f"largest Lyapunov exponent (1/s; standard error {chaos.lyapunov_stderr:.3f}), angle limit "
-                   "30 deg, no force cap, eight",
+                   f"{studies.CHAOS_DEG} deg, no force cap, eight",
                    f"chaotic at {len(cha)} of {len(free)} angle limits from {SWEEP_DEG[0]} to {SWEEP_DEG[-1]} deg "
                    "without a cap (Chapter 4)")
 

@@ -26,9 +26,9 @@ from ..tracking.mismatch import mismatch_study
 from ..tracking.runs import run
 from ..trajectories import circle, eight
 
-__all__ = ["R0", "THETA0", "FIG4_CAP", "SWEEP_DEG", "LYAPUNOV_DEG", "HORIZONS", "MIRROR_OFFSETS_DEG", "fig4_run", "angle_sweep",
-           "torus", "lyapunov_convergence", "mirror_starts", "mirror_attractors", "wrong_model", "circle_run",
-           "full_loop_sample", "limits_comparison"]
+__all__ = ["R0", "THETA0", "FIG4_CAP", "SWEEP_DEG", "CHAOS_DEG", "LYAPUNOV_DEG", "HORIZONS", "MIRROR_OFFSETS_DEG",
+           "fig4_run", "angle_sweep", "chaos_row", "torus", "lyapunov_convergence", "mirror_starts",
+           "mirror_attractors", "wrong_model", "circle_run", "full_loop_sample", "limits_comparison"]
 
 #: the paper's circle (its Table), and Chapter 3's eight, in m and rad/s
 R0, THETA0 = 2.0, math.pi / 4
@@ -36,6 +36,8 @@ R0, THETA0 = 2.0, math.pi / 4
 FIG4_CAP = 4.0
 #: Chapter 4's bifurcation sweep, every whole degree of the angle limit
 SWEEP_DEG = np.arange(10, 91)
+#: the angle limit (deg) of that sweep without a cap whose exponent the report and the front page quote
+CHAOS_DEG = 30
 #: Chapter 4's exponent convergence, its angle limits (deg) and horizons (periods after the transient)
 LYAPUNOV_DEG, HORIZONS = (30, 45), (48, 120, 240, 480)
 #: Chapter 4's heading offsets of the starts whose attractors it maps (deg)
@@ -77,6 +79,23 @@ def angle_sweep(body: Body, gains: Gains, cap):
         moved starts) and runs.
     """
     return cached(confirmed_limit_verdicts, body, gains, eight(R0, THETA0), np.radians(SWEEP_DEG), cap)
+
+
+def chaos_row(free):
+    """The row at :data:`CHAOS_DEG` of :func:`angle_sweep`'s frame without a cap, whose exponent
+    and standard error the report's chaos row and the front page quote.
+
+    Parameters
+    ----------
+    free : pandas.DataFrame
+        The frame of :func:`angle_sweep` with ``cap`` None.
+
+    Returns
+    -------
+    pandas.Series
+        The row.
+    """
+    return free[free.angle_deg.round() == CHAOS_DEG].iloc[0]
 
 
 def torus(body: Body, gains: Gains):
