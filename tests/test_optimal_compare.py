@@ -88,6 +88,14 @@ def test_the_law_for_p_compiled_period_names_a_blow_up_as_the_numpy_steps_do():
             flow.end(x)
 
 
+@pytest.mark.parametrize("kw, match", [(dict(horizon=0), "horizon"), (dict(measured=3), "measured"),
+                                       (dict(horizon=10, measured=20), "measured must be at most horizon"),
+                                       (dict(measured=4.0), "measured must be an integer")])
+def test_paper_rows_names_a_horizon_it_cannot_measure(kw, match):
+    with pytest.raises((ValueError, TypeError), match=match):
+        compare.paper_rows(BODY, GAINS, trajectories.eight(), [(30, None)], **kw)
+
+
 def test_law_row_names_a_law_it_does_not_decide():
     with pytest.raises(ValueError, match="law"):
         compare.law_row(BODY, GAINS, trajectories.eight(), "paper", Limits(4.0))

@@ -249,13 +249,18 @@ def paper_rows(body: Body, gains: Gains, ref, settings=SETTINGS, *, horizon: int
     settings : sequence of tuple
         (angle limit in deg or None, cap in N or None).
     horizon, measured : int
-        Periods run and measured without an orbit.
+        Periods run and measured without an orbit (``measured`` at least two blocks of
+        :data:`RMS_BLOCK` periods, at most ``horizon``).
 
     Returns
     -------
     list of dict
         One per setting: regime, reason, floquet, the measures and ``rms_stderr``.
     """
+    horizon = checks.integer("horizon", horizon, minimum=1)
+    measured = checks.integer("measured", measured, minimum=2 * RMS_BLOCK)
+    if measured > horizon:
+        raise ValueError(f"measured must be at most horizon ({horizon} periods), got {measured}")
     angles = np.array([math.pi if a is None else math.radians(a) for a, _ in settings])
     caps = np.array([np.inf if c is None else c for _, c in settings])
     frame = limit_verdicts(body, gains, ref, angles, caps)[0]
