@@ -161,8 +161,15 @@ def test_sweep_columns_and_the_lost_definition(perturb):
     drifting = ~orbit & (df.slip.abs() > 3 * df.slip_stderr + 1e-3)
     np.testing.assert_array_equal(df.lost, (df.regime == "slipping") | drifting)
     np.testing.assert_array_equal(df.turns_round, df["range"] > 2 * np.pi)
-    # the chaotic point turns right round without a net drift: not lost, but it turns round
-    assert df.lost.tolist() == [False, False, True, False, False]
+    # on an orbit lost is exact: the slipping orbit, and only it
+    assert df.lost[orbit].tolist() == [False, True, False, False]
+    # the chaotic point turns right round without a net drift. Its drift is a statistic of one
+    # trajectory, which the last bits choose, and lost on it is a 3-standard-error test: measured
+    # 0.3, -2.2, 1.5 and 3.4 errors from the two starts before and after the stages' cos and sin
+    # changed in their last bits (lib.integrators.trig), a spread about twice the batch-means
+    # error (README). So no flag here; the drift within 6 errors
+    ch = df.iloc[1]
+    assert abs(ch.slip) < 6 * ch.slip_stderr  # reason: twice the 3-error test, for the spread above
     assert df.turns_round.tolist()[:3] == [False, True, True]
     assert (df.floquet[orbit] < 1).all() and (df.residual[orbit] <= 1e-10).all()  # reason: the residual within the verdicts' newton_tol
 

@@ -48,7 +48,7 @@ LAST = ("errata", "report", "intro")
 KERNEL_ENV = {"OPENBLAS_NUM_THREADS": "1"}
 #: a page's CPU time (s), measured (the log of ``make book`` from an empty ``_build``, numba's
 #: kernels compiled, 2026-11-27), to start the longest first (unknown pages first of all)
-COST = {"chapters/04_limits": 94, "chapters/05_stability": 89, "chapters/08_optimal": 33,
+COST = {"chapters/04_limits": 94, "chapters/05_stability": 74, "chapters/08_optimal": 33,
         "chapters/03_tracking": 17, "chapters/06_allocation": 15, "chapters/07_percussion": 13,
         "chapters/02_controllability": 10, "chapters/01_model": 3, "methods": 1}
 

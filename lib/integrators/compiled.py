@@ -1,7 +1,8 @@
 """The compiled engine of the batch integrator for the reduced rotation equation: the
 fixed-step scheme of :func:`lib.integrators.batch.steps` (8th-order Dormand-Prince)
 run over one reference period, one point per parallel numba loop, on the field
-:func:`lib.rotation.field.rotation_rates` compiled from its one definition. About
+:func:`lib.rotation.field.rotation_rates_cs` compiled from its one definition, at the cos and sin
+of each stage's heading taken from its step's (:func:`lib.integrators.trig.cos_sin_near`). About
 ten times faster than the vectorised numpy engine on the Fig. 5 grid (see
 ``benchmarks/bench_eight_sweep.py``); the tests check the two agree to rounding.
 """
@@ -11,11 +12,14 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ..rotation.field import rotation_rates, rotation_rates_with_dphi
+from ..rotation.field import rotation_rates_cs
+from .trig import cos_sin_near
 
 __all__ = ["rotation_period", "rotation_flow", "overdamped_period"]
 
-_rates = numba.njit(rotation_rates)
+# the field given cos and sin of the stage's heading, which cos_sin_near takes from the step's
+_rates = numba.njit(rotation_rates_cs)
+_near = numba.njit(cos_sin_near)
 
 
 @numba.njit(cache=True, parallel=True)
@@ -26,12 +30,14 @@ def _kernel(phi, w, A, B, C, X1, Y1, X2, Y2, hA, hB, out, out_w):
         kw = np.empty(stages)
         f, v, a_, b_, c_ = phi[q], w[q], A[q], B[q], C[q]
         for j in range(n):
+            c0, s0 = np.cos(f), np.sin(f)
             for i in range(stages):
-                ps, ws = f, v
+                dp, ws = 0.0, v
                 for l in range(i):
-                    ps += hA[i, l] * kp[l]
+                    dp += hA[i, l] * kp[l]
                     ws += hA[i, l] * kw[l]
-                kp[i], kw[i] = _rates(ps, ws, a_, b_, c_, X1[j, i], Y1[j, i], X2[j, i], Y2[j, i])
+                cp, sp = _near(c0, s0, f, dp)
+                kp[i], kw[i], _ = _rates(cp, sp, ws, a_, b_, c_, X1[j, i], Y1[j, i], X2[j, i], Y2[j, i])
             for i in range(stages):
                 f += hB[i] * kp[i]
                 v += hB[i] * kw[i]
@@ -73,9 +79,6 @@ def rotation_period(phi, w, A, B, C, h, X1, Y1, X2, Y2, hA, hB):
 
 # ---------------------------------------------------------------- the period map with its Jacobian
 
-_rates_jac = numba.njit(rotation_rates_with_dphi)
-
-
 @numba.njit(cache=True, parallel=True)
 def _flow_kernel(phi, w, J, A, B, C, periods, X1, Y1, X2, Y2, hA, hB, jac, renorm, track, H, wind2pi,
                  logs, sec, pmin, pmax):
@@ -99,12 +102,13 @@ def _flow_kernel(phi, w, J, A, B, C, periods, X1, Y1, X2, Y2, hA, hB, jac, renor
         lo, hi = pmin[q], pmax[q]
         for per in range(periods[q]):
             for j in range(n):
+                cf, sf = np.cos(f), np.sin(f)
                 for i in range(stages):
-                    ps, ws = f, v
+                    dp, ws = 0.0, v
                     s0, s1, s2, s3 = j0, j1, j2, j3
                     for l in range(i):
                         c = hA[i, l]
-                        ps += c * kp[l]
+                        dp += c * kp[l]
                         ws += c * kw[l]
                         if jac:
                             s0 += c * k0[l]
@@ -112,15 +116,16 @@ def _flow_kernel(phi, w, J, A, B, C, periods, X1, Y1, X2, Y2, hA, hB, jac, renor
                             if full:
                                 s1 += c * k1[l]
                                 s3 += c * k3[l]
+                    cp, sp = _near(cf, sf, f, dp)
                     if jac:
-                        kp[i], kw[i], d = _rates_jac(ps, ws, a_, b_, c_, X1[j, i], Y1[j, i], X2[j, i], Y2[j, i])
+                        kp[i], kw[i], d = _rates(cp, sp, ws, a_, b_, c_, X1[j, i], Y1[j, i], X2[j, i], Y2[j, i])
                         k0[i] = s2
                         k2[i] = d * s0 - a_ * s2
                         if full:
                             k1[i] = s3
                             k3[i] = d * s1 - a_ * s3
                     else:
-                        kp[i], kw[i] = _rates(ps, ws, a_, b_, c_, X1[j, i], Y1[j, i], X2[j, i], Y2[j, i])
+                        kp[i], kw[i], _ = _rates(cp, sp, ws, a_, b_, c_, X1[j, i], Y1[j, i], X2[j, i], Y2[j, i])
                 for i in range(stages):
                     f += hB[i] * kp[i]
                     v += hB[i] * kw[i]
@@ -216,14 +221,13 @@ def rotation_flow(phi, w, A, B, C, periods, X1, Y1, X2, Y2, hA, hB, *, J=None, j
 
 
 @numba.njit(cache=True)
-def _overdamped_rate(phi, j, A, B, C, X1, Y1, X2, Y2, X3, Y3, corrected):
+def _overdamped_rate(cp, sp, j, A, B, C, X1, Y1, X2, Y2, X3, Y3, corrected):
     """phi_s of the overdamped heading, or with the first inertia correction
-    (:func:`lib.rotation.slow_eight._rate`): the torque T of :func:`lib.rotation.field.rotation_rates` at
-    rest (w = 0), its derivative along the path T_s (the same field one derivative up) and in
-    phi (:func:`lib.rotation.field.rotation_rates_dphi`), their formulas written out to share one
-    cos and one sin, term by term in the same order, so the values are those of the separate
-    definitions to the last bit."""
-    cp, sp = np.cos(phi), np.sin(phi)
+    (:func:`lib.rotation.slow_eight._rate`), at the heading of cos cp and sin sp: the torque T of
+    :func:`lib.rotation.field.rotation_rates` at rest (w = 0), its derivative along the path T_s
+    (the same field one derivative up) and in phi (:func:`lib.rotation.field.rotation_rates_dphi`),
+    their formulas written out to share the one cos and sin, term by term in the same order, so
+    the values are those of the separate definitions to the last bit."""
     T = (B * Y1[j] + C * Y2[j]) * cp - (B * X1[j] + C * X2[j]) * sp - A * 0.0
     if not corrected:
         return T / A
@@ -240,10 +244,14 @@ def _overdamped_kernel(phi, A, B, C, X1, Y1, X2, Y2, X3, Y3, n, corrected):
         x, a_, b_, c_ = phi[q], A[q], B[q], C[q]
         for i in range(n):
             j = 2 * i
-            k1 = _overdamped_rate(x, j, a_, b_, c_, X1, Y1, X2, Y2, X3, Y3, corrected)
-            k2 = _overdamped_rate(x + 0.5 * h * k1, j + 1, a_, b_, c_, X1, Y1, X2, Y2, X3, Y3, corrected)
-            k3 = _overdamped_rate(x + 0.5 * h * k2, j + 1, a_, b_, c_, X1, Y1, X2, Y2, X3, Y3, corrected)
-            k4 = _overdamped_rate(x + h * k3, j + 2, a_, b_, c_, X1, Y1, X2, Y2, X3, Y3, corrected)
+            c0, s0 = np.cos(x), np.sin(x)
+            k1 = _overdamped_rate(c0, s0, j, a_, b_, c_, X1, Y1, X2, Y2, X3, Y3, corrected)
+            cp, sp = _near(c0, s0, x, 0.5 * h * k1)
+            k2 = _overdamped_rate(cp, sp, j + 1, a_, b_, c_, X1, Y1, X2, Y2, X3, Y3, corrected)
+            cp, sp = _near(c0, s0, x, 0.5 * h * k2)
+            k3 = _overdamped_rate(cp, sp, j + 1, a_, b_, c_, X1, Y1, X2, Y2, X3, Y3, corrected)
+            cp, sp = _near(c0, s0, x, h * k3)
+            k4 = _overdamped_rate(cp, sp, j + 2, a_, b_, c_, X1, Y1, X2, Y2, X3, Y3, corrected)
             x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
         out[q] = x
     return out
@@ -255,7 +263,8 @@ def overdamped_period(phi, A, B, C, forcing, n: int, corrected: bool) -> np.ndar
     numba loop, from ``phi`` (rad) with coefficients ``A, B, C`` (broadcast with ``phi``);
     ``forcing`` is the unit eight's six derivatives (X', Y', X'', Y'', X''', Y''') at the
     2 n + 1 half-step phases. The same arithmetic as the vectorised numpy steps, point by
-    point; only the libm's cos and sin may differ in the last bit.
+    point, but for the cos and sin of the stages' headings, taken from the step's
+    (:func:`lib.integrators.trig.cos_sin_near`): they differ in the last bit.
 
     Parameters
     ----------

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..params import Body
 
-__all__ = ["coefficients", "rotation_rates", "rotation_rates_dphi", "rotation_rates_with_dphi"]
+__all__ = ["coefficients", "rotation_rates", "rotation_rates_dphi", "rotation_rates_with_dphi", "rotation_rates_cs"]
 
 
 def coefficients(body: Body, R, Theta):
@@ -85,8 +85,8 @@ def rotation_rates_dphi(phi, B, C, X1, Y1, X2, Y2):
 
 def rotation_rates_with_dphi(phi, w, A, B, C, X1, Y1, X2, Y2):
     """(phi', w', d w'/d phi): :func:`rotation_rates` and :func:`rotation_rates_dphi` at
-    once, sharing one cos and one sin, for the variational equation of the compiled
-    engine. The same operations in the same order, so the values are bit-identical to
+    once, sharing one cos and one sin (:func:`rotation_rates_cs`, which the compiled engine
+    runs). The same operations in the same order, so the values are bit-identical to
     the two definitions (``tests/test_rotation_verdicts.py`` checks it at random states).
 
     Parameters
@@ -103,7 +103,26 @@ def rotation_rates_with_dphi(phi, w, A, B, C, X1, Y1, X2, Y2):
     tuple of numpy.ndarray
         (d phi / ds, d w / ds, d w' / d phi).
     """
-    cp, sp = np.cos(phi), np.sin(phi)
+    return rotation_rates_cs(np.cos(phi), np.sin(phi), w, A, B, C, X1, Y1, X2, Y2)
+
+
+def rotation_rates_cs(cp, sp, w, A, B, C, X1, Y1, X2, Y2):
+    """:func:`rotation_rates_with_dphi` given cp = cos phi and sp = sin phi instead of phi:
+    the compiled engine takes a stage's pair from its step's
+    (:func:`lib.integrators.trig.cos_sin_near`).
+
+    Parameters
+    ----------
+    cp, sp : array_like
+        cos phi and sin phi.
+    w, A, B, C, X1, Y1, X2, Y2 : array_like
+        As in :func:`rotation_rates`.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (d phi / ds, d w / ds, d w' / d phi).
+    """
     P = B * Y1 + C * Y2
     Q = B * X1 + C * X2
     return w, P * cp - Q * sp - A * w, -P * sp - Q * cp
