@@ -9,9 +9,12 @@ ten times faster than the vectorised numpy engine on the Fig. 5 grid (see
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numba
 import numpy as np
 
+from ..machinery.cache import source_stamp
 from ..rotation.field import rotation_rates_cs
 from .trig import cos_sin_near
 
@@ -20,30 +23,6 @@ __all__ = ["rotation_period", "rotation_flow", "overdamped_period"]
 # the field given cos and sin of the stage's heading, which cos_sin_near takes from the step's
 _rates = numba.njit(rotation_rates_cs)
 _near = numba.njit(cos_sin_near)
-
-
-@numba.njit(cache=True, parallel=True)
-def _kernel(phi, w, A, B, C, X1, Y1, X2, Y2, hA, hB, out, out_w):
-    n, stages = X1.shape
-    for q in numba.prange(phi.size):
-        kp = np.empty(stages)
-        kw = np.empty(stages)
-        f, v, a_, b_, c_ = phi[q], w[q], A[q], B[q], C[q]
-        for j in range(n):
-            c0, s0 = np.cos(f), np.sin(f)
-            for i in range(stages):
-                dp, ws = 0.0, v
-                for l in range(i):
-                    dp += hA[i, l] * kp[l]
-                    ws += hA[i, l] * kw[l]
-                cp, sp = _near(c0, s0, f, dp)
-                kp[i], kw[i], _ = _rates(cp, sp, ws, a_, b_, c_, X1[j, i], Y1[j, i], X2[j, i], Y2[j, i])
-            for i in range(stages):
-                f += hB[i] * kp[i]
-                v += hB[i] * kw[i]
-            out[j, q] = f
-            out_w[j, q] = v
-        phi[q], w[q] = f, v
 
 
 def rotation_period(phi, w, A, B, C, h, X1, Y1, X2, Y2, hA, hB):
@@ -79,78 +58,6 @@ def rotation_period(phi, w, A, B, C, h, X1, Y1, X2, Y2, hA, hB):
 
 # ---------------------------------------------------------------- the period map with its Jacobian
 
-@numba.njit(cache=True, parallel=True)
-def _flow_kernel(phi, w, J, A, B, C, periods, X1, Y1, X2, Y2, hA, hB, jac, renorm, track, H, wind2pi,
-                 logs, sec, pmin, pmax):
-    """``periods[q]`` periods for point q of (phi, w) and, with ``jac``, of the variational
-    matrix J[q] = (V00, V01, V10, V11), V = d(phi, w) / d(phi0, w0), by the same stages.
-    With ``renorm`` only the first column of V is carried: a tangent vector, renormalised
-    after every period, the log of its growth stored in logs[period, q]. The states at the
-    end of every period go to sec[period, q] (raw phi, w); with ``track`` pmin/pmax hold the
-    extremes of p = phi - H - wind2pi * period over every step end."""
-    n, stages = X1.shape
-    full = jac and not renorm
-    for q in numba.prange(phi.size):
-        kp = np.empty(stages)
-        kw = np.empty(stages)
-        k0 = np.empty(stages)
-        k1 = np.empty(stages)
-        k2 = np.empty(stages)
-        k3 = np.empty(stages)
-        f, v, a_, b_, c_ = phi[q], w[q], A[q], B[q], C[q]
-        j0, j1, j2, j3 = J[q, 0], J[q, 1], J[q, 2], J[q, 3]
-        lo, hi = pmin[q], pmax[q]
-        for per in range(periods[q]):
-            for j in range(n):
-                cf, sf = np.cos(f), np.sin(f)
-                for i in range(stages):
-                    dp, ws = 0.0, v
-                    s0, s1, s2, s3 = j0, j1, j2, j3
-                    for l in range(i):
-                        c = hA[i, l]
-                        dp += c * kp[l]
-                        ws += c * kw[l]
-                        if jac:
-                            s0 += c * k0[l]
-                            s2 += c * k2[l]
-                            if full:
-                                s1 += c * k1[l]
-                                s3 += c * k3[l]
-                    cp, sp = _near(cf, sf, f, dp)
-                    if jac:
-                        kp[i], kw[i], d = _rates(cp, sp, ws, a_, b_, c_, X1[j, i], Y1[j, i], X2[j, i], Y2[j, i])
-                        k0[i] = s2
-                        k2[i] = d * s0 - a_ * s2
-                        if full:
-                            k1[i] = s3
-                            k3[i] = d * s1 - a_ * s3
-                    else:
-                        kp[i], kw[i], _ = _rates(cp, sp, ws, a_, b_, c_, X1[j, i], Y1[j, i], X2[j, i], Y2[j, i])
-                for i in range(stages):
-                    f += hB[i] * kp[i]
-                    v += hB[i] * kw[i]
-                if jac:
-                    for i in range(stages):
-                        j0 += hB[i] * k0[i]
-                        j2 += hB[i] * k2[i]
-                        if full:
-                            j1 += hB[i] * k1[i]
-                            j3 += hB[i] * k3[i]
-                if track:
-                    p = f - H[j] - wind2pi * per
-                    lo = min(lo, p)
-                    hi = max(hi, p)
-            sec[per, q, 0] = f
-            sec[per, q, 1] = v
-            if renorm:
-                norm = np.sqrt(j0 * j0 + j2 * j2)
-                logs[per, q] = np.log(norm)
-                j0 /= norm
-                j2 /= norm
-        phi[q], w[q] = f, v
-        J[q, 0], J[q, 1], J[q, 2], J[q, 3] = j0, j1, j2, j3
-        pmin[q], pmax[q] = lo, hi
-
 
 def rotation_flow(phi, w, A, B, C, periods, X1, Y1, X2, Y2, hA, hB, *, J=None, jac: bool = True,
                   renorm: bool = False, H=None, wind2pi: float = 0.0):
@@ -159,7 +66,7 @@ def rotation_flow(phi, w, A, B, C, periods, X1, Y1, X2, Y2, hA, hB, *, J=None, j
     points in parallel, by the fixed-step scheme of :func:`rotation_period` (the unit
     reference's derivatives tabulated at the stage phases, (n steps, stages); ``hA``,
     ``hB`` the tableau times the step). With ``jac`` the variational equation (its
-    phi-derivative from :func:`lib.rotation.field.rotation_rates_with_dphi`) is run with the
+    phi-derivative from :func:`lib.rotation.field.rotation_rates_cs`) is run with the
     same stages, so J is the exact Jacobian of the discrete map. ``J`` (N, 2, 2) is the
     initial variational matrix (identity by default). With ``renorm`` its first column
     is a tangent vector renormalised every period (for the largest Lyapunov exponent); the
@@ -236,25 +143,158 @@ def _overdamped_rate(cp, sp, j, A, B, C, X1, Y1, X2, Y2, X3, Y3, corrected):
     return T / A - (Ts + Tphi * T / A) / A**2
 
 
-@numba.njit(cache=True, parallel=True)
-def _overdamped_kernel(phi, A, B, C, X1, Y1, X2, Y2, X3, Y3, n, corrected):
-    out = np.empty_like(phi)
-    h = 2 * np.pi / n
-    for q in numba.prange(phi.size):
-        x, a_, b_, c_ = phi[q], A[q], B[q], C[q]
-        for i in range(n):
-            j = 2 * i
-            c0, s0 = np.cos(x), np.sin(x)
-            k1 = _overdamped_rate(c0, s0, j, a_, b_, c_, X1, Y1, X2, Y2, X3, Y3, corrected)
-            cp, sp = _near(c0, s0, x, 0.5 * h * k1)
-            k2 = _overdamped_rate(cp, sp, j + 1, a_, b_, c_, X1, Y1, X2, Y2, X3, Y3, corrected)
-            cp, sp = _near(c0, s0, x, 0.5 * h * k2)
-            k3 = _overdamped_rate(cp, sp, j + 1, a_, b_, c_, X1, Y1, X2, Y2, X3, Y3, corrected)
-            cp, sp = _near(c0, s0, x, h * k3)
-            k4 = _overdamped_rate(cp, sp, j + 2, a_, b_, c_, X1, Y1, X2, Y2, X3, Y3, corrected)
-            x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-        out[q] = x
-    return out
+# Numba keys a cached function on its own file, not on the functions it calls from other modules
+# (the field, the stages' cos and sin), so each kernel is made in a closure over ``stamp``, the hash
+# of those modules and this one (as lib.integrators.switched_compiled._make_run is): numba keys a
+# closure on its cells too, so an edit of any of them compiles the kernels again.
+
+def _make_period_kernel(stamp: int):
+    """The kernel of :func:`rotation_period`, closed over ``stamp``."""
+
+    @numba.njit(cache=True, parallel=True)
+    def _kernel(phi, w, A, B, C, X1, Y1, X2, Y2, hA, hB, out, out_w):
+        if stamp < 0:  # never: the closure's cell, which numba's cache keys on
+            return
+        n, stages = X1.shape
+        for q in numba.prange(phi.size):
+            kp = np.empty(stages)
+            kw = np.empty(stages)
+            f, v, a_, b_, c_ = phi[q], w[q], A[q], B[q], C[q]
+            for j in range(n):
+                c0, s0 = np.cos(f), np.sin(f)
+                for i in range(stages):
+                    dp, ws = 0.0, v
+                    for l in range(i):
+                        dp += hA[i, l] * kp[l]
+                        ws += hA[i, l] * kw[l]
+                    cp, sp = _near(c0, s0, f, dp)
+                    kp[i], kw[i], _ = _rates(cp, sp, ws, a_, b_, c_, X1[j, i], Y1[j, i], X2[j, i], Y2[j, i])
+                for i in range(stages):
+                    f += hB[i] * kp[i]
+                    v += hB[i] * kw[i]
+                out[j, q] = f
+                out_w[j, q] = v
+            phi[q], w[q] = f, v
+
+    return _kernel
+
+
+def _make_flow_kernel(stamp: int):
+    """The kernel of :func:`rotation_flow`, closed over ``stamp``."""
+
+    @numba.njit(cache=True, parallel=True)
+    def _flow_kernel(phi, w, J, A, B, C, periods, X1, Y1, X2, Y2, hA, hB, jac, renorm, track, H, wind2pi,
+                     logs, sec, pmin, pmax):
+        """``periods[q]`` periods for point q of (phi, w) and, with ``jac``, of the variational
+        matrix J[q] = (V00, V01, V10, V11), V = d(phi, w) / d(phi0, w0), by the same stages.
+        With ``renorm`` only the first column of V is carried: a tangent vector, renormalised
+        after every period, the log of its growth stored in logs[period, q]. The states at the
+        end of every period go to sec[period, q] (raw phi, w); with ``track`` pmin/pmax hold the
+        extremes of p = phi - H - wind2pi * period over every step end."""
+        if stamp < 0:  # never: the closure's cell, which numba's cache keys on
+            return
+        n, stages = X1.shape
+        full = jac and not renorm
+        for q in numba.prange(phi.size):
+            kp = np.empty(stages)
+            kw = np.empty(stages)
+            k0 = np.empty(stages)
+            k1 = np.empty(stages)
+            k2 = np.empty(stages)
+            k3 = np.empty(stages)
+            f, v, a_, b_, c_ = phi[q], w[q], A[q], B[q], C[q]
+            j0, j1, j2, j3 = J[q, 0], J[q, 1], J[q, 2], J[q, 3]
+            lo, hi = pmin[q], pmax[q]
+            for per in range(periods[q]):
+                for j in range(n):
+                    cf, sf = np.cos(f), np.sin(f)
+                    for i in range(stages):
+                        dp, ws = 0.0, v
+                        s0, s1, s2, s3 = j0, j1, j2, j3
+                        for l in range(i):
+                            c = hA[i, l]
+                            dp += c * kp[l]
+                            ws += c * kw[l]
+                            if jac:
+                                s0 += c * k0[l]
+                                s2 += c * k2[l]
+                                if full:
+                                    s1 += c * k1[l]
+                                    s3 += c * k3[l]
+                        cp, sp = _near(cf, sf, f, dp)
+                        if jac:
+                            kp[i], kw[i], d = _rates(cp, sp, ws, a_, b_, c_, X1[j, i], Y1[j, i], X2[j, i], Y2[j, i])
+                            k0[i] = s2
+                            k2[i] = d * s0 - a_ * s2
+                            if full:
+                                k1[i] = s3
+                                k3[i] = d * s1 - a_ * s3
+                        else:
+                            kp[i], kw[i], _ = _rates(cp, sp, ws, a_, b_, c_, X1[j, i], Y1[j, i], X2[j, i], Y2[j, i])
+                    for i in range(stages):
+                        f += hB[i] * kp[i]
+                        v += hB[i] * kw[i]
+                    if jac:
+                        for i in range(stages):
+                            j0 += hB[i] * k0[i]
+                            j2 += hB[i] * k2[i]
+                            if full:
+                                j1 += hB[i] * k1[i]
+                                j3 += hB[i] * k3[i]
+                    if track:
+                        p = f - H[j] - wind2pi * per
+                        lo = min(lo, p)
+                        hi = max(hi, p)
+                sec[per, q, 0] = f
+                sec[per, q, 1] = v
+                if renorm:
+                    norm = np.sqrt(j0 * j0 + j2 * j2)
+                    logs[per, q] = np.log(norm)
+                    j0 /= norm
+                    j2 /= norm
+            phi[q], w[q] = f, v
+            J[q, 0], J[q, 1], J[q, 2], J[q, 3] = j0, j1, j2, j3
+            pmin[q], pmax[q] = lo, hi
+
+    return _flow_kernel
+
+
+def _make_overdamped_kernel(stamp: int):
+    """The kernel of :func:`overdamped_period`, closed over ``stamp``."""
+
+    @numba.njit(cache=True, parallel=True)
+    def _overdamped_kernel(phi, A, B, C, X1, Y1, X2, Y2, X3, Y3, n, corrected, out):
+        if stamp < 0:  # never: the closure's cell, which numba's cache keys on
+            return
+        h = 2 * np.pi / n
+        for q in numba.prange(phi.size):
+            x, a_, b_, c_ = phi[q], A[q], B[q], C[q]
+            for i in range(n):
+                j = 2 * i
+                c0, s0 = np.cos(x), np.sin(x)
+                k1 = _overdamped_rate(c0, s0, j, a_, b_, c_, X1, Y1, X2, Y2, X3, Y3, corrected)
+                cp, sp = _near(c0, s0, x, 0.5 * h * k1)
+                k2 = _overdamped_rate(cp, sp, j + 1, a_, b_, c_, X1, Y1, X2, Y2, X3, Y3, corrected)
+                cp, sp = _near(c0, s0, x, 0.5 * h * k2)
+                k3 = _overdamped_rate(cp, sp, j + 1, a_, b_, c_, X1, Y1, X2, Y2, X3, Y3, corrected)
+                cp, sp = _near(c0, s0, x, h * k3)
+                k4 = _overdamped_rate(cp, sp, j + 2, a_, b_, c_, X1, Y1, X2, Y2, X3, Y3, corrected)
+                x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            out[q] = x
+
+    return _overdamped_kernel
+
+
+def _sources_stamp() -> int:
+    """A hash of the modules the kernels compile in (as a 60-bit integer)."""
+    here = Path(__file__)
+    return source_stamp(here, here.parents[1] / "rotation" / "field.py", here.with_name("trig.py"))
+
+
+_STAMP = _sources_stamp()
+_kernel = _make_period_kernel(_STAMP)
+_flow_kernel = _make_flow_kernel(_STAMP)
+_overdamped_kernel = _make_overdamped_kernel(_STAMP)
 
 
 def overdamped_period(phi, A, B, C, forcing, n: int, corrected: bool) -> np.ndarray:
@@ -286,5 +326,6 @@ def overdamped_period(phi, A, B, C, forcing, n: int, corrected: bool) -> np.ndar
     """
     phi, A, B, C = (np.ascontiguousarray(x, dtype=float) for x in np.broadcast_arrays(phi, A, B, C))
     f = [np.ascontiguousarray(x, dtype=float) for x in forcing]
-    out = _overdamped_kernel(phi.ravel(), A.ravel(), B.ravel(), C.ravel(), *f, int(n), bool(corrected))
+    out = np.empty(phi.size)
+    _overdamped_kernel(phi.ravel(), A.ravel(), B.ravel(), C.ravel(), *f, np.int64(n), np.bool_(corrected), out)
     return out.reshape(phi.shape)

@@ -144,9 +144,9 @@ def _advance(P, lim, mode, t0, s, n_steps, h, A, b, c, K, ys, y1, y2, g0, g1, g2
 
 
 def _sources_stamp() -> int:
-    """A hash of the three modules whose kernels ``_run`` compiles in (as a 60-bit integer)."""
+    """A hash of the four modules whose kernels ``_run`` compiles in (as a 60-bit integer)."""
     return source_stamp(*(Path(__file__).with_name(name)
-                          for name in ("switched_field.py", "switched_events.py", "switched_compiled.py")))
+                          for name in ("switched_field.py", "switched_events.py", "switched_compiled.py", "trig.py")))
 
 
 def _make_run(stamp: int):

@@ -29,10 +29,16 @@ No state is interpolated: every landing state comes from a real step from the st
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 
-from .switched_field import N_EVENTS, _field
+from .switched_field import _TH, N_EVENTS, _field, _field_cs
+from .trig import cos_sin_near
+
+# a stage's cos and sin of the reference's phase and of the heading, from its step's
+_near = numba.njit(cos_sin_near)
 
 # the constants these kernels pass to one another are typed values (np.int64, np.bool_), not
 # literals, which numba would compile into a copy of the callee each (switched_compiled: _LITERALS)
@@ -55,8 +61,13 @@ def _step(P, lim, mode, t, s, h, A, b, c, K, ys, out, g):
     functions at its end into ``g``, the rates there into ``ys``. ``K[0]`` must hold the
     rates at (t, s) under ``mode`` already (the first stage, c[0] = 0, does not depend on
     h): the caller has them from the end of the step before, or from the field evaluated
-    after an event, or from the first try of this step (``_advance``)."""
+    after an event, or from the first try of this step (``_advance``). The stages' cos and
+    sin of the reference's phase and of the heading come from the start's
+    (:func:`lib.integrators.trig.cos_sin_near`): one libm sincos each a step."""
     n_st = c.size
+    th, p0 = P[_TH], s[2]
+    k0 = th * t
+    ck0, sk0, cp0, sp0 = math.cos(k0), math.sin(k0), math.cos(p0), math.sin(p0)
     for i in range(1, n_st):
         for q in range(6):
             ys[q] = s[q]
@@ -64,14 +75,18 @@ def _step(P, lim, mode, t, s, h, A, b, c, K, ys, out, g):
             if A[i, j] != 0.0:
                 for q in range(6):
                     ys[q] += h * A[i, j] * K[j, q]
-        _field(P, lim, mode, t + c[i] * h, ys, K[i], g)
+        ck, sk = _near(ck0, sk0, k0, th * (t + c[i] * h) - k0)
+        cp, sp = _near(cp0, sp0, p0, ys[2] - p0)
+        _field_cs(P, lim, mode, ck, sk, cp, sp, ys, K[i], g)
     for q in range(6):
         acc = 0.0
         for i in range(n_st):
             if b[i] != 0.0:
                 acc += b[i] * K[i, q]
         out[q] = s[q] + h * acc
-    _field(P, lim, mode, t + h, out, ys, g)
+    ck, sk = _near(ck0, sk0, k0, th * (t + h) - k0)
+    cp, sp = _near(cp0, sp0, p0, out[2] - p0)
+    _field_cs(P, lim, mode, ck, sk, cp, sp, out, ys, g)
 
 
 @numba.njit

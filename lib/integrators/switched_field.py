@@ -28,13 +28,18 @@ _M, _I, _A, _C, _CPHI, _KPX, _KPY, _KVX, _KVY, _R, _TH, _KSLIDE, _KIND = range(1
 @numba.njit
 def _kin(P, t):
     """Position, velocity, acceleration and jerk of the reference (circle (27) or eight (28))."""
+    s = P[_TH] * t
+    return _kin_cs(P, math.cos(s), math.sin(s))
+
+
+@numba.njit
+def _kin_cs(P, c1, s1):
+    """:func:`_kin` at the phase s = Theta t of cos c1 and sin s1."""
     R, th = P[_R], P[_TH]
-    s = th * t
     if P[_KIND] == 0.0:
-        c, sn = math.cos(s), math.sin(s)
+        c, sn = c1, s1
         return (R * c, R * sn, -R * th * sn, R * th * c, -R * th**2 * c, -R * th**2 * sn,
                 R * th**3 * sn, -R * th**3 * c)
-    c1, s1 = math.cos(s), math.sin(s)
     c2, s2 = (c1 - s1) * (c1 + s1), 2 * s1 * c1  # cos 2s, sin 2s: one sincos, not two
     return (0.5 * R * s2, R * s1, R * th * c2, R * th * c1, -2 * R * th**2 * s2, -R * th**2 * s1,
             -4 * R * th**3 * c2, -R * th**3 * c1)
@@ -44,13 +49,21 @@ def _kin(P, t):
 def _field(P, lim, mode, t, s, out, g):
     """Rates of state s under ``mode`` into ``out`` (6,), event functions into ``g`` (4,);
     ``lim`` = (beta_max, cos beta_max, sin beta_max, F_max)."""
+    k = P[_TH] * t
+    return _field_cs(P, lim, mode, math.cos(k), math.sin(k), math.cos(s[2]), math.sin(s[2]), s, out, g)
+
+
+@numba.njit
+def _field_cs(P, lim, mode, ck, sk, c, sn, s, out, g):
+    """:func:`_field` given cos and sin of the reference's phase Theta t (ck, sk) and of the
+    heading s[2] (c, sn): a step takes its stages' from its start's
+    (:func:`lib.integrators.trig.cos_sin_near`)."""
     bmax, cb, sb, fmax = lim
     m, I, a, cc, cphi = P[_M], P[_I], P[_A], P[_C], P[_CPHI]
-    xd, yd, vxd, vyd, axd, ayd, jxd, jyd = _kin(P, t)
-    x, y, phi, vx, vy, w = s[0], s[1], s[2], s[3], s[4], s[5]
+    xd, yd, vxd, vyd, axd, ayd, jxd, jyd = _kin_cs(P, ck, sk)
+    x, y, vx, vy, w = s[0], s[1], s[3], s[4], s[5]
     tx = m * axd + cc * vx + P[_KVX] * (vxd - vx) + P[_KPX] * (xd - x)
     ty = m * ayd + cc * vy + P[_KVY] * (vyd - vy) + P[_KPY] * (yd - y)
-    c, sn = math.cos(phi), math.sin(phi)
     lat, lon = ty * c - tx * sn, tx * c + ty * sn
     tn = math.sqrt(tx * tx + ty * ty)
     F = min(tn, fmax)
