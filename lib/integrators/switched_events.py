@@ -63,7 +63,7 @@ def _step(P, lim, mode, t, s, h, A, b, c, K, ys, out, g):
     h): the caller has them from the end of the step before, or from the field evaluated
     after an event, or from the first try of this step (``_advance``). The stages' cos and
     sin of the reference's phase and of the heading come from the start's
-    (:func:`lib.integrators.trig.cos_sin_near`): one libm sincos each a step."""
+    (:func:`lib.integrators.trig.cos_sin_near`): one libm sincos of each angle a step."""
     n_st = c.size
     th, p0 = P[_TH], s[2]
     k0 = th * t

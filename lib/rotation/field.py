@@ -17,7 +17,7 @@ import numpy as np
 
 from ..params import Body
 
-__all__ = ["coefficients", "rotation_rates", "rotation_rates_dphi", "rotation_rates_with_dphi", "rotation_rates_cs"]
+__all__ = ["coefficients", "rotation_rates", "rotation_rates_dphi", "rotation_rates_cs"]
 
 
 def coefficients(body: Body, R, Theta):
@@ -83,33 +83,12 @@ def rotation_rates_dphi(phi, B, C, X1, Y1, X2, Y2):
     return -(B * Y1 + C * Y2) * np.sin(phi) - (B * X1 + C * X2) * np.cos(phi)
 
 
-def rotation_rates_with_dphi(phi, w, A, B, C, X1, Y1, X2, Y2):
-    """(phi', w', d w'/d phi): :func:`rotation_rates` and :func:`rotation_rates_dphi` at
-    once, sharing one cos and one sin (:func:`rotation_rates_cs`, which the compiled engine
-    runs). The same operations in the same order, so the values are bit-identical to
-    the two definitions (``tests/test_rotation_verdicts.py`` checks it at random states).
-
-    Parameters
-    ----------
-    phi, w : array_like
-        Heading (rad) and w = d phi / ds.
-    A, B, C : array_like
-        :func:`coefficients`.
-    X1, Y1, X2, Y2 : array_like
-        The unit reference's derivatives at the phase.
-
-    Returns
-    -------
-    tuple of numpy.ndarray
-        (d phi / ds, d w / ds, d w' / d phi).
-    """
-    return rotation_rates_cs(np.cos(phi), np.sin(phi), w, A, B, C, X1, Y1, X2, Y2)
-
-
 def rotation_rates_cs(cp, sp, w, A, B, C, X1, Y1, X2, Y2):
-    """:func:`rotation_rates_with_dphi` given cp = cos phi and sp = sin phi instead of phi:
-    the compiled engine takes a stage's pair from its step's
-    (:func:`lib.integrators.trig.cos_sin_near`).
+    """(phi', w', d w'/d phi): :func:`rotation_rates` and :func:`rotation_rates_dphi` at
+    once, given cp = cos phi and sp = sin phi instead of phi, for the compiled engine, which
+    takes a stage's pair from its step's (:func:`lib.integrators.trig.cos_sin_near`). The same
+    operations in the same order as the two definitions, so at cp = cos phi, sp = sin phi the
+    values are theirs bit for bit (``tests/test_rotation_verdicts.py`` checks it at random states).
 
     Parameters
     ----------
