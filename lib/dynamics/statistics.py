@@ -1,30 +1,123 @@
 """The statistics behind the book's verdicts (:mod:`lib.dynamics.verdicts`, which re-exports
 them): a per-period series' mean with its batch-means standard error
 (:func:`block_statistics`, :func:`batch_means`), the drift per period of a quantity sampled
-at block ends (:func:`drift_statistics`), and how a section fails to come back near itself
+at block ends (:func:`drift_statistics`), the integrated autocorrelation time that sets the
+blocks (:func:`integrated_time`), and how a section fails to come back near itself
 (:func:`section_returns`, the test for a closed invariant curve).
+
+Every standard error the book quotes, and every 3-standard-error verdict, is a batch-means
+error (:func:`batch_means`): the spread of the means of consecutive blocks, over the square
+root of their number. It is honest when the blocks are long against the series' memory,
+its integrated autocorrelation time tau_int; :func:`block_statistics` therefore makes each
+series' blocks at least :data:`BLOCK_TAUS` times its own tau_int (Sokal's automatic
+window), whatever shorter block a caller asks for. The Methods page shows the calibration
+(:mod:`lib.dynamics.calibration`): the spread of an estimate over independent starts against
+the mean standard error reported.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
 from ..angles import wrap_angle
 
-__all__ = ["block_statistics", "batch_means", "drift_statistics", "section_returns"]
+__all__ = ["block_statistics", "batch_means", "drift_statistics", "integrated_time", "block_length",
+           "section_returns", "BLOCK_TAUS", "SOKAL_WINDOW"]
+
+#: a block is at least this many integrated autocorrelation times long: the batch-means
+#: variance of an AR(1) series is then biased low by less than 1 / BLOCK_TAUS (its standard
+#: error by less than half that), see :func:`block_length`
+BLOCK_TAUS = 6
+
+#: Sokal's automatic window: the autocorrelations are summed up to the first lag M >= c tau_int(M)
+SOKAL_WINDOW = 5.0
 
 
-def block_statistics(per_period, block: int) -> tuple[np.ndarray, np.ndarray]:
-    """Mean and batch-means standard error of a per-period series (N, L) over its last
-    complete blocks of ``block`` periods: the standard error is that of the block means,
-    so that correlated periods do not shrink it. Returns (mean (N,), stderr (N,)).
+def integrated_time(series, window: float = SOKAL_WINDOW) -> np.ndarray:
+    """Integrated autocorrelation time tau_int = 1/2 + sum_{k>=1} rho_k of each row of a
+    series (N, L), in samples, by Sokal's automatic windowing: the sum runs up to the first
+    lag M with M >= ``window`` tau_int(M) (A. Sokal, Monte Carlo methods in statistical
+    mechanics, 1997, Sec. 3). The standard error of the mean of L samples is
+    sqrt(2 tau_int var / L): tau_int = 1/2 for independent samples. A constant row gets 1/2.
+
+    Parameters
+    ----------
+    series : array_like
+        (N, L), L >= 2.
+    window : float
+        Sokal's c (> 0).
+
+    Returns
+    -------
+    numpy.ndarray
+        tau_int (N,), in samples.
+    """
+    x = np.asarray(series, dtype=float)
+    if x.ndim != 2 or x.shape[1] < 2:
+        raise ValueError(f"series must have shape (N, L) with L >= 2, got {x.shape}")
+    if not window > 0:
+        raise ValueError(f"window must be positive, got {window}")
+    N, L = x.shape
+    x = x - x.mean(axis=1, keepdims=True)
+    f = np.fft.rfft(x, 2 * L, axis=1)
+    acov = np.fft.irfft(f * np.conj(f), 2 * L, axis=1)[:, :L]
+    tau = np.full(N, 0.5)
+    live = acov[:, 0] > 0
+    if not live.any():
+        return tau
+    taus = 2 * np.cumsum(acov[live] / acov[live, :1], axis=1) - 1        # 2 tau_int(M), M = 0 .. L-1
+    ok = np.arange(L) >= window * 0.5 * taus
+    ok[:, -1] = True
+    m = ok.argmax(axis=1)
+    tau[live] = 0.5 * taus[np.arange(m.size), m]
+    return tau
+
+
+def block_length(per_period, block: int) -> np.ndarray:
+    """The block (periods) of each row of a per-period series (N, L) for its batch means: at
+    least ``block`` and at least :data:`BLOCK_TAUS` times the row's :func:`integrated_time`,
+    at most L // 2 (two blocks). With b >= 6 tau_int the block means of an AR(1) series (lag
+    correlation phi, 2 tau_int = (1 + phi) / (1 - phi)) have the variance 2 tau_int var / b
+    times 1 - 2 phi (1 - phi^b) / (b (1 - phi^2)), and 2 phi / (1 - phi^2) < tau_int: the
+    error is low by less than 1 / (2 BLOCK_TAUS). Returns (N,) int.
 
     Parameters
     ----------
     per_period : array_like
         A series per period (N, L).
     block : int
-        Periods per block.
+        The shortest block (periods, >= 1).
+
+    Returns
+    -------
+    numpy.ndarray
+        Periods per block (N,).
+    """
+    v = np.asarray(per_period, dtype=float)
+    if block < 1:
+        raise ValueError(f"block must be at least 1 period, got {block}")
+    L = v.shape[1]
+    if L // block < 2:
+        raise ValueError(f"need at least two blocks of {block} periods, got {L} periods")
+    b = np.maximum(block, np.ceil(BLOCK_TAUS * integrated_time(v) - 1e-9).astype(int))
+    return np.minimum(b, L // 2)
+
+
+def block_statistics(per_period, block: int) -> tuple[np.ndarray, np.ndarray]:
+    """Mean and batch-means standard error (:func:`batch_means`) of a per-period series (N, L)
+    over its last complete blocks: each row's blocks are :func:`block_length` periods, at
+    least ``block`` and at least :data:`BLOCK_TAUS` times the row's integrated
+    autocorrelation time, so that correlated periods do not shrink the error. Returns
+    (mean (N,), stderr (N,)).
+
+    Parameters
+    ----------
+    per_period : array_like
+        A series per period (N, L).
+    block : int
+        The shortest block (periods).
 
     Returns
     -------
@@ -32,20 +125,28 @@ def block_statistics(per_period, block: int) -> tuple[np.ndarray, np.ndarray]:
         (N,) each, in the series' units.
     """
     v = np.asarray(per_period, dtype=float)
+    if v.ndim != 2:
+        raise ValueError(f"per_period must have shape (N, L), got {v.shape}")
     N, L = v.shape
-    nb = L // block
-    if nb < 2:
-        raise ValueError(f"need at least two blocks of {block} periods, got {L} periods")
-    return batch_means(v[:, L - nb * block:].reshape(N, nb, block).mean(axis=2))
+    b = block_length(v, block)
+    mean, se = np.empty(N), np.empty(N)
+    for bb in np.unique(b):
+        rows = np.flatnonzero(b == bb)
+        nb = L // bb
+        mean[rows], se[rows] = batch_means(v[rows, L - nb * bb:].reshape(rows.size, nb, bb).mean(axis=2))
+    return mean, se
 
 
 def batch_means(block_means) -> tuple[np.ndarray, np.ndarray]:
-    """Mean and standard error of the means of consecutive blocks (N, nb), nb >= 2.
+    """Mean and standard error of the means of consecutive blocks (N, nb): the standard
+    deviation of the block means over sqrt(nb) (NaN for nb = 1). The one estimator of every
+    error the book quotes; honest when the blocks are long against the series' memory
+    (:func:`block_length`).
 
     Parameters
     ----------
     block_means : array_like
-        Block means (N, nb), nb >= 2.
+        Block means (N, nb).
 
     Returns
     -------
@@ -53,13 +154,17 @@ def batch_means(block_means) -> tuple[np.ndarray, np.ndarray]:
         (N,) each.
     """
     m = np.asarray(block_means, dtype=float)
-    return m.mean(axis=1), m.std(axis=1, ddof=1) / np.sqrt(m.shape[1])
+    if m.ndim != 2:
+        raise ValueError(f"block_means must have shape (N, nb), got {m.shape}")
+    if m.shape[1] < 2:                      # one block: no spread to read an error from
+        return m.mean(axis=1), np.full(m.shape[0], np.nan)
+    return m.mean(axis=1), m.std(axis=1, ddof=1) / math.sqrt(m.shape[1])
 
 
 def drift_statistics(at_block_ends, periods_per_block: float, unit: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """Drift per period of a quantity sampled at block ends (N, m + 1), in ``unit``
-    (2 pi: turns of an angle), with the standard error of its m block increments.
-    Returns (drift (N,), stderr (N,)).
+    (2 pi: turns of an angle), with the standard error of its m block increments
+    (:func:`batch_means`, m >= 2). Returns (drift (N,), stderr (N,)).
 
     Parameters
     ----------
@@ -75,8 +180,7 @@ def drift_statistics(at_block_ends, periods_per_block: float, unit: float = 1.0)
     drift, stderr : numpy.ndarray
         Per period, (N,) each.
     """
-    inc = np.diff(np.asarray(at_block_ends, dtype=float), axis=1) / (unit * periods_per_block)
-    return inc.mean(axis=1), inc.std(axis=1, ddof=1) / np.sqrt(inc.shape[1])
+    return batch_means(np.diff(np.asarray(at_block_ends, dtype=float), axis=1) / (unit * periods_per_block))
 
 
 def section_returns(sec: np.ndarray, leave: float = 0.25, angles=(0,)) -> np.ndarray:

@@ -1,0 +1,254 @@
+"""How large an error bar is: the book's standard errors (:mod:`lib.dynamics.statistics`)
+checked against the spread of the same estimate over independent starts on the same
+chaotic attractor (the Methods page, section "How large an error bar is").
+
+At each setting K runs start apart; each reports an estimate x_k and its standard error
+s_k by the procedure the book uses. When the errors are honest, the standard deviation of
+the K estimates matches the mean reported error: :func:`ensemble_ratio` gives their ratio
+with its chi-square interval (K - 1 degrees of freedom). Two flows are studied, at the
+settings of :data:`LIMIT_DEG` and :data:`FIG5_POINTS`:
+
+- the switched closed loop under an angle limit on the eight (Chapter 4, and the paper's law
+  of Chapter 8): the starts are the paper's initial state moved by :data:`START_SPREAD` in
+  every coordinate, run :data:`BURN_IN` periods (the verdicts' transient) before anything is
+  measured, far longer than chaos needs to separate them (:func:`limit_ensemble` reports how
+  far apart they end up); the exponent over :data:`LIMIT_PERIODS` periods (blocks of 12, as
+  :func:`lib.limits.verdicts.limit_verdicts`), the heading's drift over the same periods (block
+  ends every 12) and C's RMS distance from the path over the last :data:`RMS_PERIODS` of them
+  (per-period mean squares, shortest block 2, as :func:`lib.optimal.compare.paper_rows`);
+- the reduced rotation (32) at chaotic points of Fig. 5 (Chapter 5): distinct random starts
+  p(0), dp/dt(0), each decided by :func:`lib.rotation.verdicts.rotation_verdicts` itself,
+  whose exponent and drift the map reports; a start that lands on another attractor (another
+  verdict) is counted and left out.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+from ..limits.runs import switched_runs
+from ..machinery import checks
+from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
+from ..rotation.verdicts import FIG5_GRID, eight_rotation_sweep
+from ..trajectories import eight
+from .statistics import block_statistics, drift_statistics
+
+__all__ = ["ensemble_ratio", "limit_ensemble", "rotation_ensemble", "calibration_study", "LIMIT_DEG", "FIG5_POINTS",
+           "LIMIT_STARTS", "ROTATION_STARTS", "BURN_IN", "LIMIT_PERIODS", "RMS_PERIODS", "START_SPREAD",
+           "RATIO_BAND", "LEVEL"]
+
+#: the angle limits (deg) studied, without a cap, on Chapter 4's eight (R = 2 m, Theta = pi/4 rad/s)
+LIMIT_DEG = (30, 45)
+#: chaotic points of Fig. 5 studied: (i, j) on the n x n grid of :data:`FIG5_GRID`, R_i, Theta_j
+FIG5_POINTS = ((2, 26), (58, 50), (74, 58), (10, 74), (50, 82), (82, 82), (18, 90), (66, 98), (2, 98))
+#: independent starts per angle limit and per Fig. 5 point
+LIMIT_STARTS, ROTATION_STARTS = 32, 64
+#: periods run before measuring (the limit verdicts' transient), the periods measured, the RMS's last periods
+BURN_IN, LIMIT_PERIODS, RMS_PERIODS = 60, 120, 100
+#: the limit runs' starts: the paper's state moved by this much (m, rad, m/s, rad/s) in each coordinate
+START_SPREAD = 1e-6
+#: the band the ratio of spread to error must lie in, and the confidence level of its interval
+RATIO_BAND, LEVEL = (0.8, 1.25), 0.95
+
+#: blocks (periods) of the limit verdicts' exponent and drift, and the shortest block of the RMS
+_LIMIT_BLOCK, _RMS_BLOCK = 12, 2
+#: samples a period of the limit runs' RMS (the per-period mean square by the rectangle rule)
+_RMS_SAMPLES = 20
+
+
+def ensemble_ratio(estimates, stderrs, level: float = LEVEL) -> dict:
+    """The spread of K estimates of one quantity from independent starts (their sample
+    standard deviation s) over the mean of their reported standard errors, and its
+    ``level`` confidence interval: (K - 1) s^2 / sigma^2 is chi-square on K - 1 degrees of
+    freedom, so sigma lies in s sqrt((K - 1) / q_hi) .. s sqrt((K - 1) / q_lo) (the mean error,
+    an average of K, taken as known). With K = 16 the interval is about [0.7, 1.5] times the
+    ratio, with K = 64 about [0.85, 1.2]. Returns a dict: K, mean, spread, stderr (the mean
+    error), ratio, lo, hi.
+
+    Parameters
+    ----------
+    estimates : array_like
+        The K estimates (K,), finite, K >= 3.
+    stderrs : array_like
+        Their standard errors (K,), finite and positive.
+    level : float
+        The confidence level, in (0, 1).
+
+    Returns
+    -------
+    dict
+        K, mean, spread, stderr, ratio, lo, hi.
+    """
+    x = np.asarray(estimates, dtype=float)
+    s = np.asarray(stderrs, dtype=float)
+    if x.ndim != 1 or x.size < 3 or not np.all(np.isfinite(x)):
+        raise ValueError(f"estimates must be at least 3 finite values (K,), got shape {x.shape}")
+    if s.shape != x.shape or not np.all(np.isfinite(s)) or not np.all(s > 0):
+        raise ValueError(f"stderrs must be {x.size} finite positive values, as many as the estimates")
+    if not 0 < level < 1:
+        raise ValueError(f"level must lie in (0, 1), got {level}")
+    K = x.size
+    spread, mean_se = float(x.std(ddof=1)), float(s.mean())
+    ratio = spread / mean_se
+    q_lo, q_hi = stats.chi2.ppf([(1 - level) / 2, (1 + level) / 2], K - 1)
+    return dict(K=K, mean=float(x.mean()), spread=spread, stderr=mean_se, ratio=ratio,
+                lo=ratio * math.sqrt((K - 1) / q_hi), hi=ratio * math.sqrt((K - 1) / q_lo))
+
+
+def limit_ensemble(body: Body, gains: Gains, angle_deg: float, starts: int = LIMIT_STARTS, *,
+                   seed: int = 0) -> pd.DataFrame:
+    """``starts`` runs of the switched closed loop on the eight (R = 2 m, Theta = pi/4 rad/s)
+    under the angle limit ``angle_deg`` (deg, no cap), from the paper's state moved by
+    :data:`START_SPREAD` times standard normal numbers (``seed``) in each coordinate, each
+    measured after :data:`BURN_IN` periods as Chapters 4 and 8 measure one run: the largest
+    Lyapunov exponent (1/s) over :data:`LIMIT_PERIODS` periods, blocks of 12
+    (:func:`lib.dynamics.statistics.block_statistics`); the heading's drift (turns of
+    p = phi - phi_d per period) from p at the ends of those blocks
+    (:func:`lib.dynamics.statistics.drift_statistics`); C's RMS distance from the path (m)
+    over the last :data:`RMS_PERIODS` periods, from the per-period mean squares (shortest
+    block 2), its error carried to the RMS by the derivative. Returns one row per start:
+    lyapunov, lyapunov_stderr, drift, drift_stderr, rms, rms_stderr; the frame's ``attrs``
+    hold ``separation``, the smallest distance between two starts' states after the burn-in
+    (m, rad, m/s, rad/s, max-norm, heading modulo 2 pi), against START_SPREAD at the start.
+
+    Parameters
+    ----------
+    body, gains : Body, Gains
+        The body and the gains of (23).
+    angle_deg : float
+        The angle limit (deg), in (0, 180].
+    starts : int
+        Starts (>= 3).
+    seed : int
+        The seed of the starts' offsets.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per start.
+    """
+    angle = math.radians(checks.number("angle_deg", angle_deg, positive=True))
+    if angle > math.pi:
+        raise ValueError(f"angle_deg must be at most 180, got {angle_deg}")
+    K = checks.integer("starts", starts, minimum=3)
+    ref = eight(2.0, math.pi / 4)
+    rng = np.random.default_rng(seed)
+    S0 = np.concatenate([PAPER_Z0, PAPER_DZ0])[None] + START_SPREAD * rng.standard_normal((K, 6))
+    runs = switched_runs(body, gains, ref, np.full(K, angle), None, s0=S0, n_periods=BURN_IN + LIMIT_PERIODS,
+                         lyapunov_from=BURN_IN, record=(BURN_IN + LIMIT_PERIODS - RMS_PERIODS, _RMS_SAMPLES))
+    T = ref.period
+    lam, lam_se = block_statistics(runs.log_growth[:, :LIMIT_PERIODS], _LIMIT_BLOCK)
+    t = runs.t[BURN_IN:]
+    p = runs.states[:, BURN_IN:, 2] - ref.z(t)[:, 2][None]
+    drift, drift_se = drift_statistics(p[:, ::_LIMIT_BLOCK], _LIMIT_BLOCK, 2 * np.pi)
+    n = RMS_PERIODS * _RMS_SAMPLES
+    rec, rt = runs.recorded[:, :n], runs.recorded_t[:n]
+    d2 = np.sum((rec[..., :2] - ref.z(rt)[None, :, :2]) ** 2, axis=2).reshape(K, RMS_PERIODS, _RMS_SAMPLES).mean(axis=2)
+    ms, ms_se = block_statistics(d2, _RMS_BLOCK)
+    rms = np.sqrt(ms)
+    first = runs.states[:, BURN_IN].copy()
+    first[:, 2] = np.mod(first[:, 2], 2 * np.pi)
+    gaps = np.abs(first[:, None] - first[None])
+    gaps[..., 2] = np.minimum(gaps[..., 2], 2 * np.pi - gaps[..., 2])
+    gap = gaps.max(axis=2)[np.triu_indices(K, 1)].min()
+    frame = pd.DataFrame(dict(lyapunov=lam / T, lyapunov_stderr=lam_se / T, drift=drift, drift_stderr=drift_se,
+                              rms=rms, rms_stderr=ms_se / (2 * rms)))
+    frame.attrs["separation"] = float(gap)
+    return frame
+
+
+def rotation_ensemble(body: Body, R: float, Theta: float, starts: int = ROTATION_STARTS, *,
+                      seed: int = 0) -> pd.DataFrame:
+    """``starts`` runs of the reduced rotation (32) on the eight at (R (m), Theta (rad/s)), from
+    distinct random starts p(0) uniform in [-pi, pi) rad and dp/dt(0) uniform in
+    [-Theta/2, Theta/2) rad/s (``seed``), each decided by
+    :func:`lib.rotation.verdicts.eight_rotation_sweep` with the map's defaults: the frame of
+    that function, one row per start (regime, lyapunov, lyapunov_stderr, slip, slip_stderr, ...).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    R : float
+        The eight's size (m), > 0.
+    Theta : float
+        Its rate (rad/s), > 0.
+    starts : int
+        Starts (>= 3).
+    seed : int
+        The seed of the starts.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per start.
+    """
+    R = checks.number("R", R, positive=True)
+    Theta = checks.number("Theta", Theta, positive=True)
+    K = checks.integer("starts", starts, minimum=3)
+    rng = np.random.default_rng(seed)
+    p0 = rng.uniform(-np.pi, np.pi, K)
+    v0 = rng.uniform(-0.5, 0.5, K) * Theta
+    return eight_rotation_sweep(body, np.full(K, R), np.full(K, Theta), p0=p0, v0=v0)
+
+
+def _rows(setting: str, frame: pd.DataFrame, columns, level: float) -> list:
+    return [dict(setting=setting, estimator=name, **ensemble_ratio(frame[x], frame[se], level))
+            for name, x, se in columns]
+
+
+def calibration_study(body: Body, gains: Gains, *, limit_starts: int = LIMIT_STARTS,
+                      rotation_starts: int = ROTATION_STARTS, level: float = LEVEL, seed: int = 0) -> pd.DataFrame:
+    """The ensemble study of the Methods page: :func:`ensemble_ratio` of every estimator the
+    book quotes with an error or decides a verdict by, at each angle limit of
+    :data:`LIMIT_DEG` (:func:`limit_ensemble`, ``limit_starts`` starts: the exponent, the
+    drift, the RMS distance) and at each Fig. 5 point of :data:`FIG5_POINTS`
+    (:func:`rotation_ensemble`, ``rotation_starts`` starts: the exponent and the drift, over
+    the starts the map decides ``chaotic``). One row per setting and estimator: setting,
+    estimator, K, mean, spread, stderr, ratio, lo, hi, and: flow ("limit" or "rotation"),
+    chaotic (starts decided chaotic, of ``starts``; all of them for the limit runs, which
+    are not decided) and separation (the limit runs' smallest distance between two starts
+    after the burn-in, NaN for the rotation).
+
+    Parameters
+    ----------
+    body, gains : Body, Gains
+        The body and the gains of (23).
+    limit_starts, rotation_starts : int
+        Starts per setting (>= 3).
+    level : float
+        The confidence level of the intervals.
+    seed : int
+        The seed of the starts.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per setting and estimator.
+    """
+    checks.instance("body", body, Body)
+    checks.instance("gains", gains, Gains)
+    limit_starts = checks.integer("limit_starts", limit_starts, minimum=3)
+    rotation_starts = checks.integer("rotation_starts", rotation_starts, minimum=3)
+    if not 0 < level < 1:
+        raise ValueError(f"level must lie in (0, 1), got {level}")
+    rows = []
+    for deg in LIMIT_DEG:
+        fr = limit_ensemble(body, gains, deg, limit_starts, seed=seed)
+        for r in _rows(f"{deg} deg", fr, (("exponent", "lyapunov", "lyapunov_stderr"),
+                                          ("drift", "drift", "drift_stderr"), ("RMS", "rms", "rms_stderr")), level):
+            rows.append(dict(r, flow="limit", chaotic=limit_starts, separation=fr.attrs["separation"]))
+    n = FIG5_GRID["n"]
+    Rg, Tg = np.linspace(*FIG5_GRID["R"], n), np.linspace(*FIG5_GRID["Theta"], n)
+    for i, j in FIG5_POINTS:
+        fr = rotation_ensemble(body, Rg[i], Tg[j], rotation_starts, seed=seed)
+        ch = fr[fr.regime == "chaotic"]
+        label = f"R = {Rg[i]:.2f} m, Theta = {Tg[j]:.2f} rad/s"
+        for r in _rows(label, ch, (("exponent", "lyapunov", "lyapunov_stderr"), ("drift", "slip", "slip_stderr")),
+                       level):
+            rows.append(dict(r, flow="rotation", chaotic=len(ch), separation=np.nan))
+    return pd.DataFrame(rows)

@@ -1,0 +1,133 @@
+"""The book's standard errors against series whose error is known exactly, and the ensemble
+study that calibrates them (lib.dynamics.statistics, lib.dynamics.calibration)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from lib.dynamics import calibration as cal
+from lib.dynamics import statistics as st
+from lib.params import Body, Gains
+
+PHI, N_SERIES, LENGTH = 0.8, 200, 4000
+
+
+def ar1(phi, n_series, length, seed=0):
+    """AR(1) series x_t = phi x_{t-1} + e_t, e standard normal, started in its stationary law."""
+    rng = np.random.default_rng(seed)
+    e = rng.standard_normal((n_series, length))
+    x = np.empty_like(e)
+    x[:, 0] = e[:, 0] / math.sqrt(1 - phi ** 2)
+    for t in range(1, length):
+        x[:, t] = phi * x[:, t - 1] + e[:, t]
+    return x
+
+
+def exact_se(phi, length):
+    """The asymptotic standard error of the mean of an AR(1) series: sigma_x sqrt(2 tau_int / n),
+    sigma_x^2 = 1 / (1 - phi^2), 2 tau_int = (1 + phi) / (1 - phi)."""
+    return math.sqrt((1 + phi) / (1 - phi) / (1 - phi ** 2) / length)
+
+
+@pytest.fixture(scope="module")
+def series():
+    return ar1(PHI, N_SERIES, LENGTH)
+
+
+def test_integrated_time_of_an_ar1_series_is_its_exact_value(series):
+    tau = st.integrated_time(series)
+    exact = (1 + PHI) / (2 * (1 - PHI))
+    # Sokal: var(tau) ~ 2 (2M + 1) / n tau^2 with the window M ~ 5 tau; the window's
+    # truncation biases it by about exp(-5) relatively; the mean of N_SERIES estimates
+    M = st.SOKAL_WINDOW * exact
+    sd = math.sqrt(2 * (2 * M + 1) / LENGTH) / math.sqrt(N_SERIES)
+    assert abs(tau.mean() / exact - 1) < math.exp(-st.SOKAL_WINDOW) + 4 * sd + 2 * exact / LENGTH
+
+
+def test_integrated_time_of_independent_samples_is_one_half():
+    x = np.random.default_rng(1).standard_normal((100, 2000))
+    tau = st.integrated_time(x)
+    assert abs(tau.mean() - 0.5) < 0.05
+    assert st.integrated_time(np.ones((2, 10))).tolist() == [0.5, 0.5]      # a constant row
+
+
+def test_block_statistics_error_matches_the_exact_error_of_an_ar1_mean(series):
+    mean, se = st.block_statistics(series, 2)          # a caller asking for blocks of 2 periods
+    exact = exact_se(PHI, LENGTH)
+    b = st.block_length(series, 2)
+    nb = LENGTH // b
+    # each error has a relative spread 1 / sqrt(2 (nb - 1)); their mean N_SERIES times less;
+    # the blocks of >= BLOCK_TAUS tau_int make it low by at most 1 / (2 BLOCK_TAUS)
+    sd = np.mean(1 / np.sqrt(2 * (nb - 1))) / math.sqrt(N_SERIES)
+    ratio = se.mean() / exact
+    assert 1 - 1 / (2 * st.BLOCK_TAUS) - 4 * sd < ratio < 1 + 4 * sd
+    # and the spread of the means themselves agrees with the exact error
+    assert abs(mean.std(ddof=1) / exact - 1) < 4 / math.sqrt(2 * (N_SERIES - 1))
+
+
+def test_blocks_shorter_than_the_memory_would_shrink_the_error(series):
+    # the same series in fixed blocks of 2 periods: the error the correlated periods shrink,
+    # by sqrt(1 - 2 phi (1 - phi^2) / (2 (1 - phi^2))) = sqrt(1 - phi) for AR(1)
+    _, se2 = st.batch_means(series.reshape(N_SERIES, -1, 2).mean(axis=2))
+    assert se2.mean() / exact_se(PHI, LENGTH) < 0.6
+    assert (st.block_length(series, 2) >= st.BLOCK_TAUS * 4.5 * 0.7).all()
+
+
+def test_block_length_keeps_the_callers_block_for_a_series_without_memory():
+    x = np.random.default_rng(2).standard_normal((50, 120))
+    assert (st.block_length(x, 12) == 12).all()
+    with pytest.raises(ValueError, match="block"):
+        st.block_length(x, 0)
+    with pytest.raises(ValueError, match="two blocks"):
+        st.block_length(x, 61)
+
+
+def test_the_ratio_interval_covers_one_as_often_as_its_level():
+    rng = np.random.default_rng(3)
+    K, trials = 16, 400
+    hits = 0
+    for _ in range(trials):
+        r = cal.ensemble_ratio(rng.normal(0.0, 2.0, K), np.full(K, 2.0))
+        hits += r["lo"] <= 1 <= r["hi"]
+    assert abs(hits / trials - cal.LEVEL) < 4 * math.sqrt(cal.LEVEL * (1 - cal.LEVEL) / trials)
+
+
+def test_the_ratio_interval_of_16_starts_is_about_0_7_to_1_5():
+    r = cal.ensemble_ratio(np.array([-1.0, 1.0] * 8), np.full(16, 1.0))
+    assert r["K"] == 16
+    assert 0.68 < r["lo"] / r["ratio"] < 0.76 and 1.45 < r["hi"] / r["ratio"] < 1.6
+
+
+@pytest.mark.parametrize("estimates, stderrs, level, name", [
+    ([1.0, 2.0], [1.0, 1.0], 0.95, "estimates"),
+    ([1.0, np.nan, 2.0], [1.0, 1.0, 1.0], 0.95, "estimates"),
+    ([1.0, 2.0, 3.0], [1.0, 0.0, 1.0], 0.95, "stderrs"),
+    ([1.0, 2.0, 3.0], [1.0, 1.0], 0.95, "stderrs"),
+    ([1.0, 2.0, 3.0], [1.0, 1.0, 1.0], 1.5, "level"),
+])
+def test_ensemble_ratio_refuses_bad_input(estimates, stderrs, level, name):
+    with pytest.raises(ValueError, match=name):
+        cal.ensemble_ratio(estimates, stderrs, level)
+
+
+def test_calibration_study_refuses_bad_input_before_any_run():
+    with pytest.raises(ValueError, match="limit_starts"):
+        cal.calibration_study(Body(), Gains(), limit_starts=2)
+    with pytest.raises(ValueError, match="rotation_starts"):
+        cal.calibration_study(Body(), Gains(), rotation_starts=0)
+    with pytest.raises(ValueError, match="level"):
+        cal.calibration_study(Body(), Gains(), level=1.0)
+    with pytest.raises(ValueError, match="angle_deg"):
+        cal.limit_ensemble(Body(), Gains(), 200.0)
+    with pytest.raises(ValueError, match="Theta"):
+        cal.rotation_ensemble(Body(), 1.0, -1.0)
+
+
+def test_starts_moved_by_a_micrometre_are_far_apart_after_the_burn_in():
+    # chaos separates them: the smallest distance between two starts' states after the
+    # burn-in is many orders above the 1e-6 they started apart
+    fr = cal.limit_ensemble(Body(), Gains(), 30.0, 3)
+    assert fr.attrs["separation"] > 1e3 * cal.START_SPREAD
+    assert (fr.lyapunov > 3 * fr.lyapunov_stderr).all()
+    assert (fr.rms_stderr > 0).all() and (fr.drift_stderr > 0).all()
