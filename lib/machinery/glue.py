@@ -19,13 +19,17 @@ def glue(name: str, value, display: bool = False) -> None:
     NumPy scalars are converted to Python numbers first: their repr
     (``np.float64(1.5)``) cannot be formatted by myst-nb's ``fmt`` spec.
     Non-finite numbers are refused: a NaN in the prose is always a bug.
+    A :class:`lib.machinery.kinds.Number` (a bound, a motion found, an estimate with its
+    error) is glued as the text its kind renders, with its value and kind beside it; the
+    page writes it with no format spec (``{glue:text}`name```), since a spec would round
+    it again, to nearest (``tests/test_number_kinds.py`` checks every one in the built book).
 
     Parameters
     ----------
     name : str
         The glue key.
     value : Any
-        A finite number or a string.
+        A finite number, a :class:`~lib.machinery.kinds.Number` or a string.
     display : bool
         Show the value in the cell's output.
 

@@ -17,6 +17,7 @@ import pandas as pd
 from scipy import stats
 
 from ..machinery.cache import cached
+from ..machinery.kinds import Kind, upper_bound
 from ..rotation.circle import circle_critical_radius
 from ..rotation.circle_global import bistable_window, torque_pendulum_threshold, window_closing_rate
 from ..limits.attractors import mirror_defect
@@ -267,9 +268,9 @@ def _check_cap_bound() -> Outcome:
     ok = b.max_error > 0.0 and bracket < 0.01 * b.max_error and b.gap < 1e-6 and above   # measured 2.4e-4 m, 6e-10
     return Outcome(legend_status(bool(ok), extension=True), b.max_error,
                    "the least largest distance (m) of C from the eight under the 4 N cap, a certified lower bound",
-                   f"a convex relaxation solved by Clarabel (duality gap {b.gap:.0e} m); a motion within "
-                   f"{bracket:.1e} m of it exists; every law of the book under the cap "
-                   f"({len(capped)} rows) leaves at least this")
+                   f"a convex relaxation solved by Clarabel (duality gap below {upper_bound(b.gap, '.0e').text()} m); "
+                   f"a motion within {upper_bound(bracket, '.1e').text()} m of it exists; every law of the book "
+                   f"under the cap ({len(capped)} rows) leaves at least this", merit_kind=Kind.LOWER.value)
 
 
 def _check_angle_optimum() -> Outcome:
@@ -288,8 +289,9 @@ def _check_angle_optimum() -> Outcome:
     return Outcome(legend_status(bool(ok), extension=True), m30.rms_error,
                    "RMS distance (m) of C from the eight of the best motion found under 30 deg and 4 N",
                    f"direct collocation (IPOPT) on (2)-(4) from several starts; each motion's inputs integrated "
-                   f"by the book's integrator return its state within {worst:.0e}; every one has a smaller RMS "
-                   "error than the paper's law at its setting (an upper bound on the least possible)")
+                   f"by the book's integrator return its state within {upper_bound(worst, '.0e').text()}; every one "
+                   "has a smaller RMS error than the paper's law at its setting (an upper bound on the least "
+                   "possible)", merit_kind=Kind.FOUND.value)
 
 
 def _check_optimal_tracker() -> Outcome:

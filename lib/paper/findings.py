@@ -23,17 +23,19 @@ from ..params import Body, Gains
 from ..percussion import percussion_fig5_map
 from ..rotation.circle_global import bistable_window
 from ..rotation.fig5 import fig5_map
-from ..simulate import OPEN_LOOP_HORIZON, open_loop_comparison
+from ..machinery.kinds import Number, best_found
+from ..simulate import OPEN_LOOP_HORIZON
 from ..trajectories import eight
 from . import studies
 from .extensions import R0, THETA0, fig5_readings, mirror_attractors
-from .report import SWEEP_DEG, _angle_sweep, outcome
+from .outcomes import Outcome
+from .report import SWEEP_DEG, _angle_sweep, open_loop_gap, outcome
 
 __all__ = ["FINDINGS", "LABELS", "findings", "front_page"]
 
 #: the report rows the front page states, each with the status it states
 FINDINGS = {
-    "eq6": "corrected", "thm6": "refuted", "thm7": "misapplied", "stlc": "refuted", "gas": "refuted",
+    "eq6": "corrected", "thm6": "refuted", "thm7": "reproduced", "stlc": "refuted", "gas": "refuted",
     "window": "extended", "fig3": "reproduced", "limit-mirror": "extended", "chaos": "reproduced",
     "quasi": "reproduced under an added condition", "fig5": "not reproducible as stated", "fig5-map": "extended",
     "weight-limit": "extended", "percussion-map": "extended", "cap-bound": "extended",
@@ -47,7 +49,7 @@ LABELS = {
         "fd_eq6_t": ("s", "inputs"), "fd_eq6_pos": ("m", "centre of mass"), "fd_eq6_heading": ("rad", "heading"),
         "fd_fig3": ("rad", "ranging"), "fd_mirror_heading": ("rad", "heading"),
         "fd_mirror_rate": ("rad/s", "turning rate"), "fd_mirror_pos": ("m", "centres of mass"),
-        "fd_chaos": ("1/s", "Lyapunov exponent"), "fd_chaos_se": ("1/s", "Lyapunov exponent"),
+        "fd_chaos": ("1/s", "Lyapunov exponent"),
         "fd_chaos_deg": ("degree", "angle limit"),
         "fd_chaos_n": ("angle limits", "chaotic"),
         "fd_chaos_cap_n": ("angle limits", "cap"), "fd_angles": ("angle limits", "chaotic"),
@@ -100,13 +102,14 @@ LABELS = {
 }
 
 
-def findings() -> dict[str, float]:
-    """The figure of merit of each row of :data:`FINDINGS`, by key.
+def findings() -> dict[str, Outcome]:
+    """The outcome of each row of :data:`FINDINGS`, by key: its figure of merit (``merit``, the
+    unit in the row's label) and the merit's kind (``number()``).
 
     Returns
     -------
     dict
-        key -> the row's figure of merit (its unit in the row's label).
+        key -> the row's :class:`~lib.paper.outcomes.Outcome`.
 
     Raises
     ------
@@ -117,16 +120,8 @@ def findings() -> dict[str, float]:
     for key, status in FINDINGS.items():
         o = outcome(key)
         assert o.status == status, (key, o.status, status)
-        out[key] = o.merit
+        out[key] = o
     return out
-
-
-def _open_loop_gap() -> tuple[float, float]:
-    """Distance (m) of the printed drift's centre of mass from the true one, and their headings'
-    difference (rad), at the end of Chapter 1's open-loop run."""
-    _, runs = open_loop_comparison(Body(), OPEN_LOOP_HORIZON)
-    d = runs["printed"][-1] - runs["config"][-1]
-    return float(math.hypot(d[0], d[1])), float(abs(np.angle(np.exp(1j * d[2]))))
 
 
 def _mirror_gap() -> np.ndarray:
@@ -139,8 +134,10 @@ def _mirror_gap() -> np.ndarray:
     return np.abs(d)
 
 
-def front_page() -> dict[str, float]:
+def front_page() -> dict[str, float | Number]:
     """Every number of the front page's findings, by glue name (the keys of ``LABELS["intro"]``).
+    A bound, a motion found and an estimate come as a :class:`~lib.machinery.kinds.Number`,
+    which the page writes as its kind says.
 
     Returns
     -------
@@ -148,7 +145,7 @@ def front_page() -> dict[str, float]:
         glue name -> value, in the unit :data:`LABELS` gives it.
     """
     f = findings()
-    pos, heading = _open_loop_gap()
+    pos, heading = open_loop_gap()
     gap = _mirror_gap()
     free, capped = _angle_sweep(None), _angle_sweep(PAPER_CAP)
     lo, hi = cached(bistable_window, Body(), THETA0)                       # Chapter 5's call
@@ -156,17 +153,17 @@ def front_page() -> dict[str, float]:
     table = studies.limits_comparison(Body(), Gains())["table"]                # Chapter 8's call
     cap_only = table[(table.cap == PAPER_CAP) & table.angle_deg.isna()].set_index("law")
     out = {
-        "fd_eq6_t": OPEN_LOOP_HORIZON, "fd_eq6_pos": pos, "fd_eq6_heading": heading, "fd_fig3": f["fig3"],
+        "fd_eq6_t": OPEN_LOOP_HORIZON, "fd_eq6_pos": pos, "fd_eq6_heading": heading, "fd_fig3": f["fig3"].merit,
         "fd_mirror_heading": gap[2], "fd_mirror_rate": gap[5], "fd_mirror_pos": float(math.hypot(gap[0], gap[1])),
-        "fd_chaos": f["chaos"], "fd_chaos_n": int((free.regime == "chaotic").sum()),
-        "fd_chaos_se": float(studies.chaos_row(free).lyapunov_stderr),
+        "fd_chaos": f["chaos"].number(".2f"), "fd_chaos_n": int((free.regime == "chaotic").sum()),
         "fd_chaos_deg": studies.CHAOS_DEG,
         "fd_chaos_cap_n": int((capped.regime == "chaotic").sum()), "fd_angles": len(SWEEP_DEG),
         "fd_window_lo": lo, "fd_window_hi": hi,
         "fd_grid": paper["grid"], "fd_not_held": paper["not_held"], "fd_lost": paper["lost"],
-        "fd_turns": paper["turns_round"], "fd_paper_held": paper["held"], "fd_weight": f["weight-limit"],
-        "fd_p_held": p_law["held"], "fd_p_grid": p_law["grid"], "fd_bound": f["cap-bound"],
-        "fd_paper_cap": float(cap_only.max_error["paper"]), "fd_opt_cap": float(cap_only.max_error["optimal"]),
+        "fd_turns": paper["turns_round"], "fd_paper_held": paper["held"], "fd_weight": f["weight-limit"].merit,
+        "fd_p_held": p_law["held"], "fd_p_grid": p_law["grid"], "fd_bound": f["cap-bound"].number(".4f"),
+        "fd_paper_cap": float(cap_only.max_error["paper"]),
+        "fd_opt_cap": best_found(float(cap_only.max_error["optimal"]), ".4f"),
     }
     assert set(out) == set(LABELS["intro"]), set(out) ^ set(LABELS["intro"])
     return out

@@ -343,6 +343,7 @@ def _errata():
                         "(`lib.controllability.free_lie_rank`) against Witt's formula, $w\\le 2$, $r\\le 3$",
             section="chapters/02_controllability",
             check=_check_count,
+            notation=True,        # a reading of what is counted: no computation of the paper uses the count
         ),
         Erratum(
             key="thm6-accessibility-stlc",
@@ -357,16 +358,20 @@ def _errata():
         ),
         Erratum(
             key="thm7-drift",
-            where="Sec. 3, Theorem 7 as used in the last sentence (\"theory 7\")",
-            printed="Theorem 7 (a system *without drift* that is locally accessible is globally controllable), "
-                    "cited to conclude that (5), a system *with* drift, is small-time locally controllable",
-            corrected="misapplied: Theorem 7 (Chow) holds for systems without drift only; (5) has a drift, and "
-                      "with a drift accessibility implies no controllability ($\\dot x_1 = u$, "
-                      "$\\dot x_2 = x_1^2$ is accessible at 0 and never lowers $x_2$)",
+            where="Sec. 3, the last sentence's \"theory 7\"",
+            printed="\"theory 7\" (a system *without drift* that is locally accessible is globally "
+                    "controllable), cited to conclude that (5), a system *with* drift, is small-time locally "
+                    "controllable",
+            corrected="a mis-citation of Theorem 6: the sentence draws Theorem 6's conclusion (STLC) for a system "
+                      "with drift, which is Theorem 6's hypothesis; Theorem 7 (Chow) concludes global "
+                      "controllability for systems without drift, which the paper never claims, and it cannot "
+                      "give that inference ($\\dot x_1 = u$, $\\dot x_2 = x_1^2$ has a drift, is accessible at "
+                      "0 and never lowers $x_2$). The inference is Theorem 6's, refuted in its row",
             verified_by="the counterexample and a driftless system checked with `accessibility_matrix`; "
                         "the body's drift at a moving state (`lib.paper.model_errata._check_theorem7`)",
             section="chapters/02_controllability",
             check=_check_theorem7,
+            notation=True,        # a citation: the inference it names is Theorem 6's, whose row decides it
         ),
         Erratum(
             key="sec3-stlc-conclusion",

@@ -11,6 +11,8 @@ from typing import Callable
 
 import numpy as np
 
+from ..machinery.kinds import Kind, Number
+
 __all__ = ["STATUSES", "Outcome", "Item", "legend_status"]
 
 STATUSES = ("reproduced", "reproduced under an added condition", "corrected", "misapplied", "refuted",
@@ -23,7 +25,11 @@ class Outcome:
     errata row it links, and what the check established beside its evidence (the flags of
     :func:`legend_status`): a counterexample to the claim as the paper uses it, a theorem used
     outside its hypotheses, a condition the paper does not state that the confirmation needs,
-    or a figure whose grid and criterion the paper does not state and that depends on them."""
+    or a figure whose grid and criterion the paper does not state and that depends on them.
+
+    The figure of merit has a kind (:class:`lib.machinery.kinds.Kind`: exact unless the check says
+    it is a certified bound, a motion found or an estimate, which carries ``merit_stderr``), and
+    :meth:`merit_text` writes it as its kind says: a lower bound rounded down, a motion found up."""
     status: str
     merit: float
     merit_label: str
@@ -33,12 +39,23 @@ class Outcome:
     misapplied: bool = False
     added_condition: bool = False
     unstated: bool = False
+    merit_kind: str = Kind.EXACT.value
+    merit_stderr: float | None = None
 
     def __post_init__(self) -> None:
         if self.status not in STATUSES:
             raise ValueError(f"unknown status {self.status!r}; known: {STATUSES}")
         if not np.isfinite(self.merit):
             raise ValueError(f"figure of merit must be finite, got {self.merit!r}")
+        self.number()                                  # the kind and its error are consistent
+
+    def number(self, fmt: str = ".3g") -> Number:
+        """The figure of merit as a :class:`~lib.machinery.kinds.Number` of its kind."""
+        return Number(float(self.merit), Kind(self.merit_kind), fmt, stderr=self.merit_stderr)
+
+    def merit_text(self, fmt: str = ".3g") -> str:
+        """The figure of merit as the report writes it (its kind decides the rounding)."""
+        return self.number(fmt).text()
 
 
 @dataclass(frozen=True)

@@ -45,6 +45,7 @@ from ..symbolic import derive_body_frame, rank_determinants
 from ..tracking.runs import steady_summary
 from ..trajectories import circle, eight, eight_heading_fourier
 from ..machinery.cache import cached
+from ..machinery.kinds import Kind
 from .errata import rows, verdict
 from .extensions import fig5_readings, items as extension_items
 from . import studies
@@ -72,8 +73,13 @@ def errata_on(item: Item) -> list[str]:
 
 def _corrected_by(key: str, merit: float, merit_label: str, note: str = "", evidence: bool = True) -> Outcome:
     v = verdict(key)                 # KeyError for a key that is not an errata row
-    return Outcome(legend_status(evidence and v.corrected_holds, printed_fails=not v.printed_holds), merit,
-                   merit_label, note or "printed form fails, corrected form holds (see the errata row)", erratum=key)
+    # a slip of notation or a reading that changes no computation links its row and corrects nothing
+    notation = next(r.notation for r in rows() if r.key == key)
+    return Outcome(legend_status(evidence and v.corrected_holds, printed_fails=not (v.printed_holds or notation)),
+                   merit, merit_label, note or ("a reading that changes no computation (see the errata row)"
+                                                if notation else
+                                                "printed form fails, corrected form holds (see the errata row)"),
+                   erratum=key)
 
 
 def _refuted_by(key: str, merit: float, merit_label: str, note: str, evidence: bool = True) -> Outcome:
@@ -104,9 +110,18 @@ def _check_input_fields() -> Outcome:
     return Outcome(legend_status(n_bad == 0), float(n_bad), "entries of (9)-(10) differing from the derivation")
 
 
+def open_loop_gap() -> tuple[float, float]:
+    """Distance (m) of the printed drift's centre of mass from the true one, and their headings'
+    difference (rad), at the end of Chapter 1's open-loop run (the front page quotes both)."""
+    _, runs = open_loop_comparison(Body(), OPEN_LOOP_HORIZON)
+    d = runs["printed"][-1] - runs["config"][-1]
+    return float(np.hypot(d[0], d[1])), float(abs(np.angle(np.exp(1j * d[2]))))
+
+
 def _check_drift() -> Outcome:
-    return _corrected_by("eq6-v2-row", _open_loop_deviations()["printed"],
-                         f"max |q_printed - q_(2)-(4)| over {OPEN_LOOP_HORIZON:g} s, open loop")
+    return _corrected_by("eq6-v2-row", open_loop_gap()[0],
+                         f"distance (m) of the printed form's centre of mass from the true one after "
+                         f"{OPEN_LOOP_HORIZON:g} s, open loop, the same inputs")
 
 
 # ------------------------------------------------------------------ Secs. 4-5
@@ -199,13 +214,16 @@ def _check_thm6() -> Outcome:
 
 
 def _check_thm7() -> Outcome:
+    # decided a mis-citation, not a misapplication: the sentence that cites "theory 7" concludes STLC
+    # for (5), which has a drift: Theorem 6's hypothesis and conclusion, not Theorem 7's (global
+    # controllability without drift, never claimed). Theorem 7 itself holds as printed (Chow).
     drift = float(np.linalg.norm(f(Body(), np.array([0.0, 0.0, 0.3, 1.0, 0.5, 0.2]))))
     v = verdict("thm7-drift")
-    return Outcome(legend_status(drift > 0 and v.confirmed, counterexample=True, misapplied=True), drift,
-                   "|f(q)| at a moving state: the drift is not zero",
-                   "Theorem 7 (Chow) is true, for systems without drift; the conclusion of Sec. 3 cites it for "
-                   "(5), which has one, and with a drift accessibility implies no controllability "
-                   "(counterexample in the errata row)", erratum="thm7-drift", counterexample=True, misapplied=True)
+    return Outcome(legend_status(drift > 0 and v.confirmed), drift,
+                   "|f(q)| at a moving state: the drift is not zero, so only Theorem 6 could give the inference",
+                   "Theorem 7 (Chow) holds as printed, for systems without drift; the paper's \"theory 7\" draws "
+                   "Theorem 6's conclusion (STLC) for (5), which has a drift: a mis-citation of Theorem 6, whose "
+                   "row is refuted", erratum="thm7-drift")
 
 
 def _check_conclusion() -> Outcome:
@@ -299,10 +317,11 @@ def _check_chaos() -> Outcome:
     cha = free[free.regime == "chaotic"]
     ok = chaos.regime == "chaotic" and chaos.lyapunov > 6 * chaos.lyapunov_stderr and len(cha) > 0
     return Outcome(legend_status(ok), chaos.lyapunov,
-                   f"largest Lyapunov exponent (1/s; standard error {chaos.lyapunov_stderr:.3f}), angle limit "
+                   f"largest Lyapunov exponent (1/s, with its standard error), angle limit "
                    f"{studies.CHAOS_DEG} deg, no force cap, eight",
                    f"chaotic at {len(cha)} of {len(free)} angle limits from {SWEEP_DEG[0]} to {SWEEP_DEG[-1]} deg "
-                   "without a cap (Chapter 4)")
+                   "without a cap (Chapter 4)", merit_kind=Kind.ESTIMATE.value,
+                   merit_stderr=float(chaos.lyapunov_stderr))
 
 
 def _check_quasi() -> Outcome:
@@ -324,8 +343,8 @@ def _check_quasi() -> Outcome:
     return Outcome(legend_status(n_alone > 0 or bool(with_cap and born), added_condition=n_alone == 0), ns.force_limit,
                    f"force cap (N) where the period-1 orbit's complex pair of multipliers crosses the unit circle, "
                    f"angle limit {NS_ANGLE_DEG:g} deg (brentq, xtol {ns.xtol:g} N)",
-                   f"only with a force cap added to the angle limit, which the paper never mentions ({n_alone} "
-                   f"of the {len(free)} angle limits without a cap are quasi-periodic): at "
+                   f"found only with a force cap added to the angle limit, which the paper never mentions ({n_alone} "
+                   f"of the {len(free)} angle limits without a cap are quasi-periodic from the paper's start): at "
                    f"{NS_ANGLE_DEG:g} deg the orbit loses stability at {ns.force_limit:.4f} N (Neimark-Sacker, "
                    f"|mu| {ns.modulus_below:.5f} and {ns.modulus_above:.5f} either side), and a torus is born "
                    f"turning by {ns.rotation:.4f} turns a period; quasi-periodic at {NS_START_CAP:g} N (Chapter 4)",
@@ -400,7 +419,8 @@ def _check_eq37() -> Outcome:
 def _check_fourier() -> Outcome:
     a = eight_heading_fourier(3)
     return _corrected_by("fourier-a3", float(a[3]), "computed a3 (rad); printed -0.24",
-                         "a1 and a5 are the computed ones rounded; a3 rounds to -0.23, not -0.24")
+                         "a1 and a5 are the computed ones rounded; a3 rounds to -0.23, not -0.24: a slip in a "
+                         "series the paper computes nothing with")
 
 
 def _check_fig5() -> Outcome:
@@ -431,10 +451,10 @@ def items() -> list[Item]:
         I("rank", "Sec. 3: rank C = 6 except where omega = a m v2 / I_C", "chapters/02_controllability",
           "corrected", _check_rank_claim),
         I("count", "Sec. 3: number of r-th order brackets w(w+1)^r/2", "chapters/02_controllability",
-          "corrected", _check_count),
+          "reproduced", _check_count),
         I("thm6", "Theorem 6: accessibility implies STLC", "chapters/02_controllability", "refuted", _check_thm6),
-        I("thm7", "Theorem 7 as used in the conclusion of Sec. 3", "chapters/02_controllability",
-          "misapplied", _check_thm7),
+        I("thm7", "Theorem 7, and \"theory 7\" in the conclusion of Sec. 3", "chapters/02_controllability",
+          "reproduced", _check_thm7),
         I("stlc", "Sec. 3 conclusion: STLC off the exceptional set", "chapters/02_controllability", "refuted",
           _check_conclusion),
         I("eq23-24", "Eqs. (23)-(24): computed torque and the error equation", "chapters/03_tracking",
@@ -466,7 +486,7 @@ def items() -> list[Item]:
         I("gas", "Sec. 6: rotation error globally asymptotically stable under (36)", "chapters/05_stability",
           "refuted", _check_gas),
         I("eq37", "Eq. (37): rotation on the eight", "chapters/05_stability", "corrected", _check_eq37),
-        I("fourier", "Sec. 6: 3-term series of the eight's tangent angle", "chapters/05_stability", "corrected",
+        I("fourier", "Sec. 6: 3-term series of the eight's tangent angle", "chapters/05_stability", "reproduced",
           _check_fourier),
         I("fig5", "Fig. 5: rotation-error range over (R, Theta)", "chapters/05_stability",
           "not reproducible as stated", _check_fig5),
@@ -493,6 +513,7 @@ def table():
     for it in items():
         out = outcome(it.key)
         records.append({"key": it.key, "paper": it.paper, "section": it.section, "expected": it.expected,
-                        "status": out.status, "merit": out.merit, "merit_label": out.merit_label,
+                        "status": out.status, "merit": out.merit, "merit_kind": out.merit_kind,
+                        "merit_text": out.merit_text(), "merit_label": out.merit_label,
                         "note": out.note, "erratum": out.erratum})
     return pd.DataFrame.from_records(records)

@@ -1,0 +1,192 @@
+"""What a number on the page is, and how its kind is written.
+
+A number the book prints is one of a few kinds (``Methods``, "A number and its kind"):
+
+- **exact**: a closed form, a symbolic or a converged computation: rounded to nearest;
+- **certified lower bound**: no motion or controller does better: rounded **down**, so that the
+  printed value is still a bound;
+- **certified upper bound**: rounded **up**, for the same reason;
+- **best found**: the value of a motion a local optimiser found: an upper bound on the least
+  possible (rounded up), never called "the best";
+- **estimate**: a statistic of a run, written with its standard error (``0.30 ± 0.02``), the
+  error rounded up;
+- **count**: an integer, of a stated total.
+
+The code that computes a number says its kind by wrapping it (:func:`lower_bound`,
+:func:`best_found`, ...); :func:`lib.machinery.glue.glue` then glues the text this module renders,
+with the unrounded value and the kind beside it, so that a test of the built book can check every
+glued bound's rounding against its value, and the words around it against its kind
+(``tests/test_number_kinds.py``). Rounding toward safety is done in decimal arithmetic
+(:mod:`decimal`), not by nudging a float.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from decimal import ROUND_CEILING, ROUND_FLOOR, ROUND_HALF_EVEN, Decimal
+from enum import Enum
+
+__all__ = ["Kind", "Number", "exact", "lower_bound", "upper_bound", "best_found", "estimate", "count",
+           "round_directed", "MIME"]
+
+#: the MIME type under which a glued number carries its value and kind beside its text
+MIME = "application/vnd.korczak.number+json"
+
+
+class Kind(str, Enum):
+    """The kind of a printed number."""
+
+    EXACT = "exact"
+    LOWER = "certified lower bound"
+    UPPER = "certified upper bound"
+    FOUND = "best found"
+    ESTIMATE = "estimate"
+    COUNT = "count"
+
+    @property
+    def rounding(self) -> str:
+        """How the kind rounds: "down", "up" or "nearest"."""
+        return {Kind.LOWER: "down", Kind.UPPER: "up", Kind.FOUND: "up"}.get(self, "nearest")
+
+
+_MODES = {"down": ROUND_FLOOR, "up": ROUND_CEILING, "nearest": ROUND_HALF_EVEN}
+
+
+def _check_fmt(fmt: str) -> tuple[int, str]:
+    if not isinstance(fmt, str) or len(fmt) < 3 or fmt[0] != "." or fmt[-1] not in "efg" or not fmt[1:-1].isdigit():
+        raise ValueError(f"fmt: a precision and a type 'e', 'f' or 'g' such as '.4f', got {fmt!r}")
+    return int(fmt[1:-1]), fmt[-1]
+
+
+def round_directed(value: float, fmt: str, rounding: str) -> str:
+    """``value`` written with the format ``fmt`` ('.4f', '.2e', '.3g'), rounded ``rounding``
+    ("down" toward minus infinity, "up" toward plus infinity, or "nearest"), in exact decimal
+    arithmetic: ``round_directed(0.10769, '.3f', 'down') == '0.107'``.
+
+    Parameters
+    ----------
+    value : float
+        A finite number.
+    fmt : str
+        A format spec with a precision and the type 'e', 'f' or 'g'.
+    rounding : str
+        "down", "up" or "nearest".
+
+    Returns
+    -------
+    str
+        The text; ``float(text)`` lies on the stated side of ``value`` (or equals it).
+    """
+    p, kind = _check_fmt(fmt)
+    if rounding not in _MODES:
+        raise ValueError(f"rounding: 'down', 'up' or 'nearest', got {rounding!r}")
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ValueError(f"value: a finite number, got {value!r}")
+    d = Decimal(float(value))                      # the double's exact decimal value
+    if kind == "f" or d == 0:
+        exponent = -p if kind == "f" else 0
+    else:                                          # 'e': p digits after the first; 'g': p in all
+        exponent = d.adjusted() - (p if kind == "e" else max(p, 1) - 1)
+    q = d.quantize(Decimal(1).scaleb(exponent), rounding=_MODES[rounding])
+    # a decimal of at most 17 significant digits is written back exactly by the float's format
+    text = format(float(q), fmt)
+    if rounding != "nearest":                      # a carry (9.99 -> 10.0) may add a digit: still exact
+        assert (Decimal(text) <= d) if rounding == "down" else (Decimal(text) >= d), (value, fmt, text)
+    return text
+
+
+@dataclass(frozen=True)
+class Number:
+    """A number with its kind, rendered by :meth:`text`.
+
+    Parameters
+    ----------
+    value : float
+        The unrounded value.
+    kind : Kind
+        What it is.
+    fmt : str
+        Its format spec ('.4f', '.2e', '.3g'); a count ignores it.
+    stderr : float or None
+        An estimate's standard error (same unit), required for an estimate and refused otherwise.
+    total : int or None
+        A count's total, if it has one.
+    """
+
+    value: float
+    kind: Kind
+    fmt: str = ".3g"
+    stderr: float | None = None
+    total: int | None = None
+
+    def __post_init__(self):
+        kind = Kind(self.kind)
+        object.__setattr__(self, "kind", kind)
+        if kind is Kind.COUNT:
+            if isinstance(self.value, bool) or int(self.value) != self.value or self.value < 0:
+                raise ValueError(f"value: a count is a non-negative integer, got {self.value!r}")
+            object.__setattr__(self, "value", int(self.value))
+            if self.total is not None and not (int(self.total) == self.total and self.total >= self.value):
+                raise ValueError(f"total: an integer at least the count {self.value}, got {self.total!r}")
+        else:
+            round_directed(float(self.value), self.fmt, "nearest")          # checks value and fmt
+            object.__setattr__(self, "value", float(self.value))
+            if self.total is not None:
+                raise ValueError(f"total: only a count has a total, not a {kind.value}")
+        if (kind is Kind.ESTIMATE) != (self.stderr is not None):
+            raise ValueError("stderr: an estimate carries its standard error, and only an estimate does")
+        if self.stderr is not None and not (math.isfinite(self.stderr) and self.stderr >= 0):
+            raise ValueError(f"stderr: a finite non-negative number, got {self.stderr!r}")
+
+    def __float__(self) -> float:
+        return float(self.value)
+
+    def text(self) -> str:
+        """The number as the page writes it: rounded as its kind says; an estimate as
+        ``value ± stderr`` (the error rounded up, the value to the error's last digit)."""
+        if self.kind is Kind.COUNT:
+            return str(self.value)
+        text = round_directed(self.value, self.fmt, self.kind.rounding)
+        if self.kind is Kind.ESTIMATE:
+            text += " ± " + round_directed(self.stderr, self.fmt, "up")
+        return text
+
+    def record(self) -> dict:
+        """The value, kind, format and text, as the glue's JSON companion."""
+        return {"value": self.value, "kind": self.kind.value, "fmt": self.fmt, "stderr": self.stderr,
+                "total": self.total, "text": self.text()}
+
+    def _repr_mimebundle_(self, include=None, exclude=None) -> dict:
+        return {"text/plain": repr(self.text()), MIME: self.record()}
+
+
+def exact(value: float, fmt: str = ".3g") -> Number:
+    """A closed form or a converged computation, rounded to nearest."""
+    return Number(value, Kind.EXACT, fmt)
+
+
+def lower_bound(value: float, fmt: str = ".3g") -> Number:
+    """A certified lower bound, rounded down."""
+    return Number(value, Kind.LOWER, fmt)
+
+
+def upper_bound(value: float, fmt: str = ".3g") -> Number:
+    """A certified upper bound, rounded up."""
+    return Number(value, Kind.UPPER, fmt)
+
+
+def best_found(value: float, fmt: str = ".3g") -> Number:
+    """The value of a motion found by a local optimiser: an upper bound on the least possible,
+    rounded up."""
+    return Number(value, Kind.FOUND, fmt)
+
+
+def estimate(value: float, stderr: float, fmt: str = ".2f") -> Number:
+    """A statistic of a run with its (calibrated) standard error, written ``value ± stderr``."""
+    return Number(value, Kind.ESTIMATE, fmt, stderr=float(stderr))
+
+
+def count(n: int, total: int | None = None) -> Number:
+    """A count, of ``total`` if given."""
+    return Number(n, Kind.COUNT, total=total)

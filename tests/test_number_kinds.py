@@ -1,0 +1,185 @@
+"""A number carries its kind, and its kind decides how it is written (lib.machinery.kinds).
+
+The fast tests check the rounding itself against exact decimal arithmetic; the book tests read
+every page as it was executed for the build (the execution cache) and check, for each glued
+number the prose writes, that a bound is rounded toward safety and that the words before a number
+("at least", "at most", ...) are true of the printed value."""
+
+from __future__ import annotations
+
+import math
+import re
+from ast import literal_eval
+from decimal import Decimal
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from lib.machinery import kinds
+from lib.machinery.kinds import Kind, Number, round_directed
+
+ROOT = Path(__file__).resolve().parents[1]
+FMTS = [".1f", ".2f", ".3f", ".4f", ".1e", ".2e", ".2g", ".3g", ".4g"]
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.floats(min_value=-1e6, max_value=1e6, allow_nan=False, allow_subnormal=False), st.sampled_from(FMTS))
+def test_a_value_rounded_down_is_never_above_it_and_up_never_below(x, fmt):
+    down, up, near = (round_directed(x, fmt, r) for r in ("down", "up", "nearest"))
+    exact = Decimal(x)
+    assert Decimal(down) <= exact <= Decimal(up)
+    # the two directed roundings are the neighbours of the exact value on the format's grid:
+    # the nearest is one of them (ties aside, where both are equally near)
+    assert near in (down, up) or abs(Decimal(near) - exact) <= abs(Decimal(down) - exact)
+
+
+def test_the_certified_bound_of_the_issue_is_written_below_itself():
+    # Chapter 8's bound was 0.10769 m and printed 0.108 (to nearest, above the bound, and above
+    # a motion that reaches 0.10776 m)
+    assert kinds.lower_bound(0.10769, ".3f").text() == "0.107"
+    assert kinds.lower_bound(0.10769, ".4f").text() == "0.1076"
+    assert kinds.best_found(0.10776, ".4f").text() == "0.1078"
+    assert kinds.upper_bound(0.10770, ".3g").text() == "0.108"
+    assert kinds.exact(0.10769, ".3f").text() == "0.108"
+
+
+def test_an_estimate_is_written_with_its_error_rounded_up():
+    assert kinds.estimate(0.3012, 0.0212, ".2f").text() == "0.30 ± 0.03"
+    assert kinds.count(364, 10000).text() == "364"
+
+
+def test_a_glued_number_carries_its_value_and_kind_beside_its_text():
+    from IPython.core.formatters import format_display_data
+    bundle, _ = format_display_data(kinds.lower_bound(0.10769, ".4f"))
+    assert literal_eval(bundle["text/plain"]) == "0.1076"
+    assert bundle[kinds.MIME]["value"] == 0.10769 and bundle[kinds.MIME]["kind"] == Kind.LOWER.value
+
+
+@pytest.mark.parametrize("bad, match", [
+    (lambda: kinds.lower_bound(float("nan")), "value"),
+    (lambda: kinds.lower_bound(1.0, "4f"), "fmt"),
+    (lambda: kinds.lower_bound(1.0, ".4d"), "fmt"),
+    (lambda: Number(1.0, Kind.EXACT, stderr=0.1), "stderr"),
+    (lambda: Number(1.0, Kind.ESTIMATE), "stderr"),
+    (lambda: kinds.estimate(1.0, -0.1), "stderr"),
+    (lambda: kinds.count(3.5), "count"),
+    (lambda: kinds.count(5, total=4), "total"),
+    (lambda: Number(1.0, "no such kind"), "no such kind"),
+    (lambda: round_directed(1.0, ".2f", "sideways"), "rounding"),
+])
+def test_a_malformed_number_is_refused_naming_what_is_wrong(bad, match):
+    with pytest.raises(ValueError, match=match):
+        bad()
+
+
+# ----------------------------------------------------------------- the words before a number
+
+#: words that make the number after them a floor ("at least x": x must not exceed the value)
+FLOOR_WORDS = ("at least", "no less than", "not below", "no closer than", "closer to the eight than",
+               "lower bound of")
+#: words that make it a ceiling ("at most x": x must not fall below the value)
+CEILING_WORDS = ("at most", "up to", "no more than", "below", "under", "within", "less than")
+GLUE_TEXT = re.compile(r"\{glue:text\}`(?:[^`:]+::)?([A-Za-z0-9_]+)(?::([^`]*))?`")
+
+
+def words_before(source: str, start: int) -> str:
+    """The few words before a glue role, on its line or the one before, lower case."""
+    head = re.sub(r"\s+", " ", source[max(0, start - 40):start]).lower()
+    return head
+
+
+def reading(head: str) -> str | None:
+    """'floor', 'ceiling' or None: what the words just before a number claim of it."""
+    tail = head.rstrip()
+    for words, kind in ((FLOOR_WORDS, "floor"), (CEILING_WORDS, "ceiling")):
+        if any(tail.endswith(w) for w in words):
+            return kind
+    return None
+
+
+def test_the_words_before_a_number_are_read_as_a_floor_or_a_ceiling():
+    assert reading("no controller can keep c closer to the eight than ") == "floor"
+    assert reading("and c ends at least ") == "floor"
+    assert reading("multipliers of modulus at most ") == "ceiling"
+    assert reading("the ratio reaches ") is None
+
+
+def rendered(text_plain: str, fmt: str | None) -> str:
+    """What myst-nb writes for a glued value with a format spec (its own function)."""
+    from myst_nb.core.variables import format_plain_text
+    return format_plain_text(text_plain, fmt or "")
+
+
+def check_page(source: str, glued: dict) -> list[str]:
+    """Every violation of the kinds' rule on one page: a bound or a motion found written with a
+    format spec, or rounded the wrong way; a number after floor or ceiling words written on the
+    wrong side of its value."""
+    bad = []
+    for m in GLUE_TEXT.finditer(source):
+        key, fmt = m.group(1), m.group(2)
+        if key not in glued:
+            continue
+        text_plain, record = glued[key]
+        try:
+            shown = float(rendered(text_plain, fmt).split(" ± ")[0])
+            value = record["value"] if record else float(literal_eval(text_plain))
+        except (ValueError, TypeError, SyntaxError):
+            continue                                       # a word, not a number
+        if record and record["kind"] != Kind.COUNT.value and fmt:
+            bad.append(f"{key}: a {record['kind']} written with the spec {fmt!r} (rounds it again)")
+        if record and Kind(record["kind"]).rounding == "down" and shown > value:
+            bad.append(f"{key}: a lower bound {value!r} printed above itself as {shown}")
+        if record and Kind(record["kind"]).rounding == "up" and shown < value:
+            bad.append(f"{key}: an upper bound {value!r} printed below itself as {shown}")
+        claim = reading(words_before(source, m.start()))
+        if claim == "floor" and shown > value:
+            bad.append(f"{key}: 'at least {shown}' but the value is {value!r}")
+        if claim == "ceiling" and shown < value:
+            bad.append(f"{key}: 'at most {shown}' but the value is {value!r}")
+    return bad
+
+
+def test_the_page_check_catches_a_bound_rounded_up_and_a_floor_above_its_value():
+    src = "no controller keeps C closer to the eight than {glue:text}`b:.3f` m"
+    assert check_page(src, {"b": (repr(0.10769), None)})          # 0.108 > 0.10769
+    bound = kinds.lower_bound(0.10769, ".4f")
+    assert not check_page("closer to the eight than {glue:text}`b` m", {"b": (repr(bound.text()), bound.record())})
+    assert check_page("than {glue:text}`b:.3f` m", {"b": (repr(bound.text()), bound.record())})
+    assert not check_page("at most {glue:text}`r:.2f`", {"r": (repr(0.0281), None)})   # 0.03 >= 0.0281
+    assert check_page("at most {glue:text}`r:.2f`", {"r": (repr(0.0241), None)})       # 0.02 < 0.0241
+
+
+def executed_pages() -> dict[str, dict]:
+    """Each page's glued values as the build executed it: page -> {key: (text/plain, record)}."""
+    from jupyter_cache import get_cache
+    from myst_nb.ext.glue import GLUE_PREFIX
+    out = {}
+    cache = get_cache(ROOT / "_build" / ".jupyter_cache")
+    for rec in cache.list_cache_records():
+        nb = cache.get_cache_bundle(rec.pk).nb
+        page = str(Path(rec.uri).resolve().relative_to(ROOT).with_suffix(""))
+        values = {}
+        for cell in nb.cells:
+            for output in cell.get("outputs", []):
+                name = output.get("metadata", {}).get("scrapbook", {}).get("name")
+                data = output.get("data", {})
+                plain = data.get(GLUE_PREFIX + "text/plain", data.get("text/plain"))
+                if name and plain is not None:
+                    values[name] = (plain, data.get(GLUE_PREFIX + kinds.MIME, data.get(kinds.MIME)))
+        out[page] = values
+    return out
+
+
+@pytest.mark.book
+def test_every_glued_bound_in_the_built_book_reads_on_its_safe_side(built_book):
+    pages = executed_pages()
+    assert len(pages) >= 10, sorted(pages)
+    bad, bounds = [], 0
+    for page, glued in pages.items():
+        bad += [f"{page}: {b}" for b in check_page((ROOT / f"{page}.md").read_text(), glued)]
+        bounds += sum(1 for _, rec in glued.values() if rec and rec["kind"] != Kind.COUNT.value)
+    assert bounds >= 5, "the book glues its bounds and motions found as numbers with their kinds"
+    assert not bad, "\n".join(bad)
