@@ -120,7 +120,8 @@ def test_limit_mirror_row_fails_with_each_of_its_clauses(monkeypatch, paper, mir
     got = _status(monkeypatch, "limit-mirror", cached=frames,
                   heading_offset_starts=_asks(starts[:12], offsets),
                   mirrored_start=_asks(starts[12:], *case, s0),
-                  mirror_defect=_asks(np.array([0.0, defect]), *case, s0, 4))
+                  mirror_defect=_asks(np.array([0.0, defect]), *case, s0, 4),
+                  mirror_gap=lambda: np.array([1.0, 1.0, 2.0, 0.1, 0.1, 0.5]))
     assert got == status
 
 

@@ -103,17 +103,23 @@ def plot_force_maps(maps, ax=None):
     -------
     matplotlib.figure.Figure
     """
-    fig, axes = (plt.subplots(1, 3, figsize=(13.5, 3.9), sharey=True) if ax is None else (ax[0].figure, ax))
+    if ax is None:       # two panels a row, so each reads at a page's width (1280 px screens)
+        fig, grid = plt.subplots(2, 2, figsize=(10.0, 7.6), sharex=True, sharey=True)
+        grid[1, 1].remove()
+        axes = (grid[0, 0], grid[0, 1], grid[1, 0])
+    else:
+        fig, axes = ax[0].figure, ax
     panels = (("F_C", "C exactly on the path: peak F (N)", "viridis", True),
               ("F_P", "P exactly on the path: peak F (N)", "viridis", True),
               ("ratio", "ratio F_P / F_C", "magma", True))
     for a, (col, label, cmap, log) in zip(axes, panels):
         v = maps[col].to_numpy(dtype=float)
         norm = plt.matplotlib.colors.LogNorm(vmin=np.nanmin(v[v > 0]), vmax=np.nanmax(v)) if log else None
-        sc = a.scatter(maps.R, maps.Theta, c=v, s=5, marker="s", cmap=cmap, norm=norm)
+        sc = a.scatter(maps.R, maps.Theta, c=v, s=14, marker="s", cmap=cmap, norm=norm)
         fig.colorbar(sc, ax=a, label=label)
         a.set_xlabel("R (m)")
-    axes[0].set_ylabel("Theta (rad/s)")
+        a.set_ylabel("Theta (rad/s)")
+        a.xaxis.set_tick_params(labelbottom=True)
     fig.tight_layout()
     return fig
 

@@ -16,7 +16,6 @@ import math
 
 import numpy as np
 
-from ..limits.attractors import half_period_mirror
 from ..machinery.cache import cached
 from ..optimal.study import PAPER_CAP
 from ..params import Body, Gains
@@ -27,7 +26,7 @@ from ..machinery.kinds import Number, best_found
 from ..simulate import OPEN_LOOP_HORIZON
 from ..trajectories import eight
 from . import studies
-from .extensions import R0, THETA0, fig5_readings, mirror_attractors
+from .extensions import R0, THETA0, fig5_readings, mirror_gap
 from .outcomes import Outcome
 from .report import SWEEP_DEG, _angle_sweep, open_loop_gap, outcome
 
@@ -124,16 +123,6 @@ def findings() -> dict[str, Outcome]:
     return out
 
 
-def _mirror_gap() -> np.ndarray:
-    """The paper's attractor at a 90 deg angle limit against its mirror image at the same phase:
-    |difference| of x, y (m), phi (rad, modulo 2 pi), their rates (m/s, rad/s)."""
-    frame, b = mirror_attractors()
-    orbit = np.asarray(frame.iloc[6].orbit, dtype=float)
-    d = half_period_mirror(Body(), Gains(), eight(R0, THETA0), b, None, orbit)[0] - orbit
-    d[2] = np.angle(np.exp(1j * d[2]))
-    return np.abs(d)
-
-
 def front_page() -> dict[str, float | Number]:
     """Every number of the front page's findings, by glue name (the keys of ``LABELS["intro"]``).
     A bound, a motion found and an estimate come as a :class:`~lib.machinery.kinds.Number`,
@@ -146,7 +135,7 @@ def front_page() -> dict[str, float | Number]:
     """
     f = findings()
     pos, heading = open_loop_gap()
-    gap = _mirror_gap()
+    gap = mirror_gap()
     free, capped = _angle_sweep(None), _angle_sweep(PAPER_CAP)
     lo, hi = cached(bistable_window, Body(), THETA0)                       # Chapter 5's call
     paper, p_law = fig5_readings(cached(fig5_map, Body())), fig5_readings(cached(percussion_fig5_map, Body()))
