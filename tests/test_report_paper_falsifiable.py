@@ -331,32 +331,20 @@ def test_eight_figure_row_fails_with_each_clause(monkeypatch, period, rng, circl
     assert out.status == status and out.merit == rng and asked == [(Body(), "eight", 2.0, np.pi / 4)]
 
 
-def _capped(amplitude=0.05, drift=0.0, n_periods=10, per=200):
-    """Fig. 4's run: a position error of the given amplitude, periodic but for a drift in the last
-    period, split between x (0.6) and y (0.8); the heading error (column 2) is large, and not
-    the position's."""
-    t = np.arange(n_periods * per + 1) / per
-    e = amplitude * np.abs(np.sin(np.pi * t))
-    e[-per:] += drift * np.sin(np.pi * t[-per:]) ** 2
-    error = np.column_stack([0.6 * e, 0.8 * e, 3.0 + np.zeros_like(e)])
-    return SimpleNamespace(t=t, error=error)
-
-
-@pytest.mark.parametrize("amplitude, drift, status", [
-    (0.05, 0.0, "reproduced"), (0.05, 0.9e-4, "reproduced"),
-    (0.05, 1.1e-4, "not reproducible"),        # the last period not the one before it
-    (0.01, 0.0, "not reproducible"),           # no error to speak of
-    (2.0, 1.8e-4, "reproduced"), (2.0, 2.2e-4, "not reproducible"),   # the drift relative to a large error
+@pytest.mark.parametrize("regime, max_error, need, status", [
+    ("periodic", 0.39, 5.5, "reproduced"),
+    ("chaotic", 0.39, 5.5, "not reproducible"),       # an error, but not periodic
+    ("periodic", 0.005, 5.5, "not reproducible"),     # no error to speak of
+    ("periodic", 0.39, 3.9, "not reproducible"),      # the cap would not bind on this eight
 ])
-def test_capped_eight_row_needs_a_non_zero_periodic_error(monkeypatch, amplitude, drift, status):
-    res = _capped(amplitude, drift)
-
-    def run(fn, *args, **kw):        # Chapter 4's call: ten periods of the eight, 4 N cap, rtol 1e-9
-        assert fn is studies.run and args == (Body(), Gains(), "eight", 2.0, np.pi / 4, 10)
-        assert kw == dict(limits=Limits(force=4.0), integration=Integration(rtol=1e-9, atol=1e-9))
-        return res
-
-    assert _status(monkeypatch, "fig4", cached=run)[0] == status
+def test_capped_eight_row_needs_a_decided_periodic_orbit_away_from_the_path(monkeypatch, regime, max_error,
+                                                                            need, status):
+    table = pd.DataFrame([dict(law="paper", cap=4.0, angle_deg=np.nan, regime=regime, max_error=max_error,
+                               floquet=0.5),
+                          dict(law="paper", cap=4.0, angle_deg=30.0, regime="chaotic", max_error=9.0,
+                               floquet=np.nan)])
+    assert _status(monkeypatch, "fig4", limits_comparison=lambda body, gains: {"table": table},
+                   exact_peak_force=lambda body, R, Theta: need)[0] == status
 
 
 def _sweep(**at30):

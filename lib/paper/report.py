@@ -46,9 +46,11 @@ from ..tracking.runs import steady_summary
 from ..trajectories import circle, eight, eight_heading_fourier
 from ..machinery.cache import cached
 from ..machinery.kinds import Kind
+from ..optimal.bound import exact_peak_force
 from .errata import rows, verdict
 from .extensions import fig5_readings, items as extension_items
 from . import studies
+from .studies import FIG4_CAP, R0, THETA0
 from .outcomes import STATUSES, Item, Outcome, legend_status
 
 __all__ = ["Outcome", "Item", "items", "outcome", "table", "STATUSES", "equation_numbers", "errata_on"]
@@ -289,16 +291,19 @@ def _check_table() -> Outcome:  # the caption's number is a slip of notation (er
 
 
 def _check_fig4() -> Outcome:
-    # Chapter 4's run of Fig. 4, shared with the chapter: ten periods of the eight from the
-    # paper's start, sampled 200 times a period
-    res = studies.fig4_run(Body(), Gains())
-    e = np.hypot(res.error[:, 0], res.error[:, 1])
-    last, prev = e[-200:], e[-400:-200]
-    amplitude, drift = float(last.max()), float(np.abs(last - prev).max())
-    ok = amplitude > 1e-2 and drift < 1e-4 * max(1.0, amplitude)
-    return Outcome(legend_status(ok), amplitude,
-                   "steady max position error (m) with F <= 4 N on the eight; periodic to 1e-4",
-                   "a non-zero periodic position error, as the paper says")
+    # "a non-zero periodic position error" decided, not waited for: the paper's law under the 4 N cap
+    # alone reaches a located attracting orbit from the paper's start (Chapter 8's side-by-side
+    # table, decided by the book's procedure), on which C stays away from the path; and the cap
+    # binds: exact tracking of the chosen eight needs more than 4 N
+    table = studies.limits_comparison(Body(), Gains())["table"]
+    row = table[(table.law == "paper") & (table.cap == FIG4_CAP) & table.angle_deg.isna()].iloc[0]
+    need = float(exact_peak_force(Body(), R0, THETA0))
+    ok = row.regime == "periodic" and row.max_error > 1e-2 and need > FIG4_CAP
+    return Outcome(legend_status(bool(ok)), float(row.max_error),
+                   "largest distance (m) of C from the eight on the paper's law's attracting orbit with F <= 4 N "
+                   "(R = 2 m, theta = pi/4 chosen: not stated in the paper)",
+                   f"a non-zero periodic position error, as the paper says: {row.regime} (largest Floquet "
+                   f"multiplier {row.floquet:.3f}); exact tracking of this eight needs {need:.3f} N")
 
 
 SWEEP_DEG = studies.SWEEP_DEG       # Chapter 4's bifurcation sweep, every whole degree
