@@ -10,6 +10,7 @@ from lib import model
 from lib.optimal import collocation as col
 from lib.optimal import motion as mo
 from lib.optimal import study
+from lib.optimal.bound import cap_bound
 from lib.params import Body
 from lib.trajectories import make
 
@@ -65,7 +66,7 @@ def test_without_limits_the_optimum_tracks_the_eight_in_the_mesh_limit():
     m40 = mo.periodic_motion(BODY, R, THETA, nodes=40, starts=("paper",))
     m80 = mo.periodic_motion(BODY, R, THETA, nodes=80, starts=("paper",))
     t = np.linspace(0, m80.period, 2001)
-    w, dw = mo._force(BODY, "eight", R, THETA, t)
+    w, dw = col._force(BODY, "eight", R, THETA, t)
     h = m80.period / 80
     # a piecewise-constant force misses the smooth w by up to h |w'| / 2; over an interval that moves C
     # by at most (h^2 / 2) (h |w'| / 2) / m; bound a period's sum of such kicks by h^2 |w'| T / m
@@ -192,7 +193,8 @@ def test_the_mesh_study_refines_the_coarse_optimum_and_finds_the_cold_one():
     # reason: the cap, with 1e-8 relative for IPOPT's constraint tolerance
     assert (fr.F_peak <= 4.0 * (1 + 1e-8)).all()
     # order 6 at the nodes: the finer mesh returns closer (a factor 16 of the 64 asked, as above)
-    assert fr.return_error[1] < fr.return_error[0] / 16
+    for q in ("position", "velocity"):
+        assert fr[f"return_{q}"][1] < fr[f"return_{q}"][0] / 16, q
 
 
 @pytest.mark.parametrize("nodes", [(40, 40), (80, 40)])
@@ -225,7 +227,7 @@ def test_bad_arguments_raise_naming_them_before_any_solve(monkeypatch, capped30,
     def forbidden(*a, **k):
         raise AssertionError("work began before the arguments were checked")
     monkeypatch.setattr(mo, "transcription", forbidden)
-    monkeypatch.setattr(mo, "paper_steady", forbidden)
+    monkeypatch.setattr(col, "paper_steady", forbidden)
     if kw.get("guess") == "R":
         kw = dict(guess=replace(capped30, R=3.0))
     elif kw.get("guess") == "kind":
@@ -243,3 +245,85 @@ def test_verify_motion_bad_arguments_raise_naming_them(capped30, kw, exc, name):
     args = dict(body=BODY, motion=capped30) | kw
     with pytest.raises(exc, match=f"^{name}"):
         mo.verify_motion(args.pop("body"), args.pop("motion"), **args)
+
+
+@pytest.fixture(scope="module")
+def cap_alone():
+    """The 4 N cap alone: the optimum at 80 intervals from every start (the convex one included),
+    refined to 160 and 320 intervals, each from the one before."""
+    chain = [mo.periodic_motion(BODY, R, THETA, F_max=4.0)]
+    for n in (160, 320):
+        chain.append(mo.periodic_motion(BODY, R, THETA, F_max=4.0, nodes=n, starts=(), guess={"coarser": chain[-1]}))
+    return chain
+
+
+def test_under_the_cap_alone_every_start_the_convex_one_included_ends_in_one_optimum(cap_alone):
+    m80 = cap_alone[0]
+    assert [s[0] for s in m80.starts] == ["paper", "force", "shifted+", "shifted-", "convex"]
+    rms = np.array([s[1] for s in m80.starts])
+    # reason: IPOPT's tol 1e-10 on the mean square moves the RMS by about 1e-9 m (START_TIE 1e-8)
+    assert np.all(np.abs(rms - m80.rms_error) < mo.START_TIE), rms
+    assert m80.best_start == "paper"                  # the first of the tied starts
+    assert [s[0] for s in cap_alone[1].starts] == ["coarser"]
+
+
+def test_under_the_cap_alone_the_best_found_converges_into_the_convex_bracket(cap_alone):
+    """The collocation holds its inputs in the body's frame, the bound's achieved motion holds the
+    world force: at the same mesh the first is worse by O(h^2). Refined, the best found falls
+    into the bound's bracket at 80 nodes, at second order, towards a limit inside the bracket at
+    256 nodes."""
+    e = [m.rms_error for m in cap_alone]
+    b80 = cap_bound(BODY, R, THETA, 4.0, nodes=80)
+    b256 = cap_bound(BODY, R, THETA, 4.0, nodes=256)
+    fine = cap_alone[-1]
+    # the certified lower bound holds for every motion's RMS over the bound's nodes; 1e-6 m for the
+    # collocation's own error (order 6: measured return error 1e-10 at 320 intervals)
+    d = fine.state(b80.t)[0][:, :2] - make("eight", R, THETA).z(b80.t)[:, :2]
+    assert math.sqrt((d ** 2).sum(1).mean()) >= b80.rms_error - 1e-6
+    assert b80.rms_error <= e[2] <= b80.rms_error_achieved, (e, b80.rms_error, b80.rms_error_achieved)
+    assert e[0] > e[1] > e[2]
+    # second order: the differences fall by 4 a halving (measured 4.0)
+    assert 3.0 < (e[0] - e[1]) / (e[1] - e[2]) < 5.0
+    limit = e[2] - (e[1] - e[2]) / 3                  # Richardson's extrapolation at order 2
+    # reason: the extrapolation's error, about its last correction's size over 4 (7e-5 m) at most
+    tol = (e[1] - e[2]) / 3 / 4
+    assert b256.rms_error - tol <= limit <= b256.rms_error_achieved + tol, (limit, b256.rms_error,
+                                                                             b256.rms_error_achieved)
+
+
+def test_return_errors_report_each_quantity_in_its_unit(capped30):
+    err = mo.return_errors(BODY, capped30)
+    assert set(err) == {"position", "heading", "velocity", "rate"}
+    worst = mo.verify_motion(BODY, capped30)
+    # the max-norm over components lies between the largest per-quantity norm over sqrt(2) and it
+    assert max(err.values()) / math.sqrt(2) <= worst * (1 + 1e-12) and worst <= max(err.values()) * (1 + 1e-12)
+
+
+def test_the_multistart_names_its_starts_and_reads_the_same_from_the_same_seed():
+    a = study.multistart(BODY, R, THETA, 30 * DEG, 4.0, n_random=2, nodes=16, seed=3)
+    b = study.multistart(BODY, R, THETA, 30 * DEG, 4.0, n_random=2, nodes=16, seed=3)
+    assert list(a.columns) == ["start", "rms_error", "converged"]
+    assert a.start.tolist()[:4] == ["paper", "force", "shifted+", "shifted-"]
+    assert a.start.tolist()[-1] == "convex" and a.start.str.startswith("heading").sum() == 2
+    assert a.start.tolist() == b.start.tolist()
+    s = study.multistart_summary(a)
+    assert s["starts"] == 7 and s["near_best"] <= s["converged"] <= 7 and s["best"] <= s["worst"]
+
+
+def test_the_motions_table_prints_a_fixed_number_of_decimals_and_the_winning_start(capped30):
+    m = replace(capped30, rms_error=0.1, max_error=0.12, starts=(("paper", 0.2, "Solve_Succeeded"),
+                                                                  ("force", 0.1, "Solve_Succeeded"),
+                                                                  ("convex", math.nan, "Maximum_Iterations")))
+    row = study.motions_table({(30, 4.0): m, (None, 4.0): capped30}).iloc[0]
+    assert (row["RMS distance (m)"], row["largest (m)"]) == ("0.1000", "0.1200")
+    assert (row["best start"], row["starts at it"]) == ("force", "1 of 3")
+
+
+@pytest.mark.parametrize("kw, exc, name", [
+    (dict(starts=("convex",)), ValueError, "starts"), (dict(shifts="a"), TypeError, "shifts"),
+    (dict(shifts=[[0.1]]), ValueError, "shifts"), (dict(guess={"a": None}), TypeError, r"guess\[a\]"),
+])
+def test_new_arguments_raise_naming_them_before_any_solve(monkeypatch, kw, exc, name):
+    monkeypatch.setattr(mo, "transcription", lambda *a, **k: pytest.fail("solved before the check"))
+    with pytest.raises(exc, match=f"^{name}"):
+        mo.periodic_motion(BODY, R, THETA, **kw)

@@ -21,24 +21,32 @@ falls like h^(2 d).
 
 The NLP depends on the body, ``nodes`` and ``degree`` only; the path (C_d at the
 collocation points), the step h and the turn 2 pi n are parameters, the limits are bounds,
-so one compiled solver (cached) serves every path, rate, limit and start.
+so one compiled solver (cached) serves every path, rate, limit and start. The starts of
+:func:`lib.optimal.motion.periodic_motion` (states at the collocation times, inputs on the
+intervals), the decision vector's bounds and the largest distance's search live here too.
 """
 
 from __future__ import annotations
+
+import math
 
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import TYPE_CHECKING
 
 import numpy as np
+from scipy.optimize import minimize_scalar
 
+from ..angles import wrap_angle
 from ..params import Body
+from ..percussion import paper_steady
+from ..trajectories import POSITIONS, make
 
 if TYPE_CHECKING:  # imported where used: casadi loads in about 1 s, most pages never call it
     import casadi as ca
 
 __all__ = ["Tableau", "tableau", "casadi_accel", "accel_function", "Transcription", "transcription",
-           "ACCEPTED", "IPOPT_OPTIONS"]
+           "ACCEPTED", "IPOPT_OPTIONS", "FREE_ANGLE", "HARMONICS"]
 
 #: IPOPT return statuses accepted as a solution
 ACCEPTED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
@@ -50,6 +58,13 @@ IPOPT_OPTIONS = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
                  "ipopt.tol": 1e-10, "ipopt.constr_viol_tol": 1e-10}
 #: the state's length; x, y, phi, x', y', phi'
 NX = 6
+#: the bound on |beta| (rad) when no angle limit is given; beta is then free, but bounded a
+#: little beyond +-pi to keep the NLP bounded (every force direction stays reachable)
+FREE_ANGLE = math.pi + 1.0
+#: harmonics of the paper's steady heading kept for the "paper" start (it is smooth)
+HARMONICS = 64
+#: dense samples per interval for the largest distance, before its refinement
+DENSE = 16
 
 
 @dataclass(frozen=True)
@@ -238,3 +253,110 @@ def transcription(body: Body, nodes: int, degree: int) -> Transcription:
     nlp = {"x": w, "p": p, "f": ca.sum2(cost) / N, "g": ca.vec(g)}
     solver = ca.nlpsol("periodic_motion", "ipopt", nlp, IPOPT_OPTIONS)
     return Transcription(nodes=N, degree=d, block=block, ng=int(nlp["g"].numel()), solver=solver)
+
+
+# The starts of :func:`lib.optimal.motion.periodic_motion` (states at the collocation times,
+# inputs on the intervals) and the bounds of the decision vector.
+
+def _force(body: Body, kind: str, R: float, Theta: float, t) -> tuple[np.ndarray, np.ndarray]:
+    """The force that keeps C on the path, w = m C_d'' + c C_d' (N), and its rate (N/s), (..., 2)."""
+    _, _, vx, vy, ax, ay, jx, jy = POSITIONS[kind](R, Theta, np.asarray(t, dtype=float))
+    w = body.m * np.stack([ax, ay], -1) + body.c * np.stack([vx, vy], -1)
+    dw = body.m * np.stack([jx, jy], -1) + body.c * np.stack([ax, ay], -1)
+    return w, dw
+
+
+@lru_cache(maxsize=16)
+def _paper_heading(body: Body, kind: str, R: float, Theta: float) -> np.ndarray:
+    """The paper's steady heading error p = phi - phi_d (rad) as complex Fourier coefficients
+    c_k (k = 0 .. HARMONICS) of p(t) = c_0 + 2 Re sum_k c_k exp(i k Theta t) (cached: the book
+    asks for it under several limits)."""
+    p = paper_steady(body, kind, R, Theta).p[:-1]
+    return np.fft.rfft(p)[:HARMONICS + 1] / len(p)
+
+
+def _fourier(coeffs: np.ndarray, Theta: float, t) -> tuple[np.ndarray, np.ndarray]:
+    """The series of :func:`_paper_heading` and its rate (rad/s) at times t (s)."""
+    k = np.arange(len(coeffs))
+    e = np.exp(1j * np.multiply.outer(np.asarray(t, dtype=float), k * Theta))
+    mult = np.where(k == 0, 1.0, 2.0)
+    return (mult * coeffs * e).sum(-1).real, (mult * 1j * k * Theta * coeffs * e).sum(-1).real
+
+
+def _path_start(body, kind, R, Theta, t_col, t_mid, heading):
+    """A start with C on the path: states at the collocation times ``t_col`` (nodes, d + 1),
+    inputs at the interval mid-times ``t_mid`` (the force w of the path, its angle to the
+    heading), the heading (phi, phi') given by ``heading(t)``."""
+    ref = make(kind, R, Theta)
+    z, dz, _ = ref.kinematics(t_col)
+    phi, dphi = heading(t_col)
+    X = np.concatenate([z[..., :2], phi[..., None], dz[..., :2], dphi[..., None]], axis=-1)
+    w, _ = _force(body, kind, R, Theta, t_mid)
+    u = np.stack([np.hypot(w[:, 0], w[:, 1]), wrap_angle(np.arctan2(w[:, 1], w[:, 0]) - heading(t_mid)[0])], -1)
+    return X, u
+
+
+def _start(name, body, kind, R, Theta, turns, t_col, t_mid, shift):
+    """The (states, inputs) of a named start (see :func:`periodic_motion`): ``"paper"`` the
+    paper's steady heading; ``"force"`` the heading along w = m C_d'' + c C_d' turned by
+    ``shift`` (rad), continuous, with a linear drift added if w's winding over a period is not
+    the path's turn n (never on the book's paths)."""
+    T = 2 * np.pi / Theta
+    ref = make(kind, R, Theta)
+    if name == "paper":
+        coeffs = _paper_heading(body, kind, R, Theta)
+
+        def heading(t):
+            p, dp = _fourier(coeffs, Theta, t)
+            zd, dzd, _ = ref.kinematics(t)
+            return zd[..., 2] + p, dzd[..., 2] + dp
+        return _path_start(body, kind, R, Theta, t_col, t_mid, heading)
+    tt = np.linspace(0.0, T, 257)
+    w, _ = _force(body, kind, R, Theta, tt)
+    ang = np.unwrap(np.arctan2(w[:, 1], w[:, 0]))
+    slip = 2 * np.pi * (turns - round((ang[-1] - ang[0]) / (2 * np.pi))) / T
+
+    def heading(t):
+        w, dw = _force(body, kind, R, Theta, t)
+        raw = np.arctan2(w[..., 1], w[..., 0])
+        near = np.interp(t, tt, ang)            # the unwrapped branch; t lies in [0, T)
+        phi = raw + 2 * np.pi * np.round((near - raw) / (2 * np.pi)) + slip * t + shift
+        rate = (w[..., 0] * dw[..., 1] - w[..., 1] * dw[..., 0]) / (w ** 2).sum(-1) + slip
+        return phi, rate
+    return _path_start(body, kind, R, Theta, t_col, t_mid, heading)
+
+
+def _bounds(tr, F_max, beta_max):
+    lo = np.full((tr.nodes, tr.block), -np.inf)
+    hi = np.full((tr.nodes, tr.block), np.inf)
+    b = FREE_ANGLE if beta_max is None else beta_max
+    lo[:, -2], hi[:, -2] = 0.0, np.inf if F_max is None else F_max
+    lo[:, -1], hi[:, -1] = -b, b
+    return lo.ravel(), hi.ravel()
+
+
+def _clip(u, F_max, beta_max):
+    b = FREE_ANGLE if beta_max is None else beta_max
+    return np.stack([np.clip(u[:, 0], 0.0, np.inf if F_max is None else F_max), np.clip(u[:, 1], -b, b)], -1)
+
+
+def _guess_start(g, t_col, t_mid):
+    z, dz = g.state(t_col)
+    F, beta = g.inputs(t_mid)
+    return np.concatenate([z, dz], -1), np.stack([F, beta], -1)
+
+
+def _max_error(motion, ref) -> float:
+    """Largest |C - C_d| (m): DENSE samples per interval, the largest refined by a bounded search."""
+    n = motion.nodes * DENSE
+    t = np.arange(n) * (motion.period / n)
+
+    def dist(tt):
+        return np.linalg.norm(motion.state(tt)[0][..., :2] - ref.z(tt)[..., :2], axis=-1)
+
+    d = dist(t)
+    i = int(np.argmax(d))
+    dt = motion.period / n
+    res = minimize_scalar(lambda s: -float(dist(s)), bounds=(t[i] - dt, t[i] + dt), method="bounded",
+                          options={"xatol": 1e-9 * motion.period})
+    return max(float(d[i]), -float(res.fun))

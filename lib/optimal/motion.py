@@ -1,22 +1,22 @@
 """The best periodic motions of the body on the circle (27) and the eight (28) under the
 paper's limits (Sec. 5): how close to the path any controller can keep C.
 
-Over one period T = 2 pi / Theta of the path, the full model (2)-(4) with inputs F >= 0
-(<= F_max if given) and |beta| <= beta_max (if given) runs a periodic motion X(T) = X(0) +
-(0, 0, 2 pi n, 0, 0, 0) (n = 0 on the eight, whose tangent oscillates about pi; n = 1 on the
-circle, whose tangent turns once a period); :func:`periodic_motion` finds the one that
-minimises the RMS distance sqrt((1/T) int_0^T |C - C_d(t)|^2 dt) of C from the path point
+The full model (2)-(4) with F >= 0 (<= F_max if given) and |beta| <= beta_max (if given) runs a
+periodic motion X(T) = X(0) + (0, 0, 2 pi n, 0, 0, 0) (T = 2 pi / Theta; n = 0 on the eight,
+1 on the circle); :func:`periodic_motion` finds one that minimises the RMS distance of C from
 C_d(t), by direct collocation solved by IPOPT (:mod:`lib.optimal.collocation`) from several
-starts (the problem is not convex), and :func:`verify_motion` integrates its piecewise-constant
-inputs with the book's integrator to check that it is a motion of the model.
+starts (the problem is not convex; the result is the best found), :func:`verify_motion` and
+:func:`return_errors` integrate its inputs to check that it is a motion of the model, and
+:func:`held_force_motion` makes the convex bound's achieved motions motions of the full model.
 
-Defaults and cost: 80 intervals of degree-3 Legendre collocation (2080 unknowns) and four
-starts ("paper", "force", "shifted+-"); one call takes about 0.4 to 1.3 s of CPU on the
-eight under an angle limit, the first call of a process about 1 s more (the paper's orbit for
-the "paper" start, and the solver's construction, both cached). Under an angle limit and
-without a force cap the optimum asks for force pulses that grow as the mesh refines (the
-infimum is approached by impulses): its RMS error moves by a few per cent between 40 and
-160 intervals, and the collocation's order shows in :func:`verify_motion` only with a cap.
+Defaults and cost: 80 intervals of degree-3 Legendre collocation (2080 unknowns), starts "paper",
+"force", "shifted+-" and, under a cap alone, "convex"; a solve takes about 0.3 to 1.3 s of CPU.
+The inputs are held in the body's frame on each interval, so the force turns with the heading
+within it; under the 4 N cap alone the heading swings up to about 0.3 rad an interval at 80
+intervals, and the best found RMS error falls as h^2 with the mesh towards the convex optimum
+(0.0731, 0.0700, 0.0692 m at 80, 160, 320 intervals; every start, the convex one included, ends
+in the same optimum). Under an angle limit without a cap the optimum asks for force pulses
+that grow as the mesh refines: its RMS error moves by a few per cent between 40 and 160 intervals.
 """
 
 from __future__ import annotations
@@ -26,34 +26,30 @@ from dataclasses import dataclass, field, replace
 from functools import lru_cache
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
-from ..angles import wrap_angle
 from ..machinery import checks
 from ..model import config_from_state, state_from_config
 from ..params import Body
-from ..percussion import paper_steady
 from ..simulate import simulate_open_loop
-from ..trajectories import KINEMATICS, POSITIONS, heading_turns, make
-from .collocation import ACCEPTED, tableau, transcription
+from ..trajectories import KINEMATICS, heading_turns, make
+from .bound import HEADING_SUBSTEPS, CapBound, _phi2, cap_bound, heading_orbit
+from .collocation import ACCEPTED, FREE_ANGLE, _bounds, _clip, _guess_start, _max_error, _start, tableau, transcription
 
-__all__ = ["PeriodicMotion", "periodic_motion", "verify_motion", "STARTS", "MAX_NODES", "FREE_ANGLE"]
+__all__ = ["PeriodicMotion", "periodic_motion", "verify_motion", "return_errors", "STARTS", "START_TIE", "MAX_NODES",
+           "FREE_ANGLE", "HeldForceMotion", "held_force_motion"]
 
-#: the starts :func:`periodic_motion` knows ("shifted" is two solves, +- beta_max / 2)
-STARTS = ("paper", "force", "shifted")
+#: the starts :func:`periodic_motion` knows ("shifted" is two solves, +- beta_max / 2; "convex"
+#: needs a cap)
+STARTS = ("paper", "force", "shifted", "convex")
+#: starts whose RMS errors (m) differ by less than this end in the same optimum (IPOPT's tol 1e-10 on
+#: the mean square moves the RMS by about 1e-9 m)
+START_TIE = 1e-8
 #: the largest mesh accepted (intervals per period)
 MAX_NODES = 2000
-#: the bound on |beta| (rad) when no angle limit is given; beta is then free, but bounded a
-#: little beyond +-pi to keep the NLP bounded (every force direction stays reachable)
-FREE_ANGLE = math.pi + 1.0
 #: the shift of the "shifted" starts' heading when no angle limit is given (rad)
 FREE_SHIFT = math.pi / 4
-#: harmonics of the paper's steady heading kept for the "paper" start (it is smooth)
-HARMONICS = 64
 #: how close (in intervals) to a node a time counts as the node
 NODE_SNAP = 1e-9
-#: dense samples per interval for the largest distance, before its refinement
-DENSE = 16
 
 
 @dataclass(frozen=True)
@@ -121,6 +117,11 @@ class PeriodicMotion:
     starts: tuple
     collocation: np.ndarray = field(repr=False)
 
+    @property
+    def best_start(self) -> str:
+        """The first start (in ``starts``' order) whose RMS lies within :data:`START_TIE` of the least."""
+        return next(n for n, rms, _ in self.starts if rms <= self.rms_error + START_TIE)
+
     def _locate(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(interval index, local time s in [0, 1), whole periods) of times t (s)."""
         t = np.asarray(t, dtype=float)
@@ -166,135 +167,136 @@ def _check_limits(F_max, beta_max):
 
 
 def _check_guess(guess, kind, R, Theta) -> tuple:
+    """((start name, motion), ...) of ``guess``: a motion, a sequence (named guess[i]) or a dict by name."""
     if guess is None:
         return ()
-    guesses = tuple(guess) if isinstance(guess, (list, tuple)) else (guess,)
-    for i, g in enumerate(guesses):
-        name = "guess" if len(guesses) == 1 and not isinstance(guess, (list, tuple)) else f"guess[{i}]"
+    if isinstance(guess, dict):
+        named = tuple((str(k), g) for k, g in guess.items())
+    else:
+        guesses = tuple(guess) if isinstance(guess, (list, tuple)) else (guess,)
+        named = tuple((f"guess[{i}]", g) for i, g in enumerate(guesses))
+    for i, (key, g) in enumerate(named):
+        name = "guess" if not isinstance(guess, (list, tuple, dict)) else f"guess[{key if isinstance(guess, dict) else i}]"
         checks.instance(name, g, PeriodicMotion)
         if g.kind != kind or not (math.isclose(g.R, R, rel_tol=1e-12) and math.isclose(g.Theta, Theta, rel_tol=1e-12)):
             raise ValueError(f"{name} must be a motion on the same path (kind {kind!r}, R = {R} m, Theta = {Theta} "
                              f"rad/s), got kind {g.kind!r}, R = {g.R} m, Theta = {g.Theta} rad/s")
-    return guesses
+    return named
 
 
-def _check_starts(starts, guesses) -> tuple:
+def _check_starts(starts, guesses, F_max, beta_max) -> tuple:
+    if starts is None:
+        return ("paper", "force", "shifted") + (("convex",) if F_max is not None and beta_max is None else ())
     if isinstance(starts, str) or not isinstance(starts, (list, tuple)):
         raise TypeError(f"starts must be a tuple of names from {list(STARTS)}, got {type(starts).__name__} {starts!r}")
     for s in starts:
         checks.one_of("starts entry", s, STARTS)
     if not starts and not guesses:
         raise ValueError("starts must name at least one start when no guess is given")
+    if "convex" in starts and F_max is None:
+        raise ValueError("starts entry 'convex' needs a force cap F_max (the convex problem is the cap's)")
     return tuple(dict.fromkeys(starts))
 
 
-def _force(body: Body, kind: str, R: float, Theta: float, t) -> tuple[np.ndarray, np.ndarray]:
-    """The force that keeps C on the path, w = m C_d'' + c C_d' (N), and its rate (N/s), (..., 2)."""
-    _, _, vx, vy, ax, ay, jx, jy = POSITIONS[kind](R, Theta, np.asarray(t, dtype=float))
-    w = body.m * np.stack([ax, ay], -1) + body.c * np.stack([vx, vy], -1)
-    dw = body.m * np.stack([jx, jy], -1) + body.c * np.stack([ax, ay], -1)
-    return w, dw
+
+@dataclass(frozen=True)
+class HeldForceMotion:
+    """A periodic motion of the full model (2)-(4) whose world-frame force ``Fw`` (N, (N, 2)) is held
+    on each node interval (:func:`held_force_motion`): C (m) and V (m/s) at the nodes ``t`` (s, (N,))
+    as :func:`lib.optimal.bound.cap_bound`'s achieved motion (closed form between them); the heading
+    on its period-1 orbit under that force (:func:`lib.optimal.bound.heading_orbit`: ``heading``
+    (N S + 1, 2) (rad, rad/s) at its RK4 steps, its ``multipliers`` and Newton's ``residual``);
+    F = |Fw| (N), beta the force's angle less phi (rad, continuous within an interval). It has what
+    :mod:`lib.optimal.tracker` asks of a motion: period (s), kind, R (m), Theta (rad/s), F_max (N),
+    beta_max (None), turns, ``state(t)``, ``inputs(t)``, the input breaks ``t``."""
+
+    body: Body
+    t: np.ndarray
+    C: np.ndarray
+    V: np.ndarray
+    Fw: np.ndarray
+    heading: np.ndarray
+    multipliers: np.ndarray
+    residual: float
+    period: float
+    kind: str
+    R: float
+    Theta: float
+    F_max: float
+    turns: int
+    objective: str
+    beta_max: None = None
+
+    def _heading(self, t):
+        """(interval k, phi, phi') at times t (s), any shape: cubic Hermite on the RK4 steps, with
+        the rates of eq. (4) at both ends (the steps never straddle a node)."""
+        t = np.asarray(t, dtype=float)
+        laps = np.floor(t / self.period)
+        dt = self.period / self.t.size / HEADING_SUBSTEPS
+        x = (t - laps * self.period) / dt
+        j = np.clip(np.floor(x).astype(int), 0, self.heading.shape[0] - 2)
+        k, r, b = j // HEADING_SUBSTEPS, x - j, self.body
+        (p0, w0), (p1, w1) = np.moveaxis(self.heading[j], -1, 0), np.moveaxis(self.heading[j + 1], -1, 0)
+        fx, fy = self.Fw[k][..., 0], self.Fw[k][..., 1]
+        a0, a1 = ((b.a * (fy * np.cos(p) - fx * np.sin(p)) - b.c_phi * w) / b.I for p, w in ((p0, w0), (p1, w1)))
+        h00, h10, h01, h11 = 2 * r**3 - 3 * r**2 + 1, dt * (r**3 - 2 * r**2 + r), 3 * r**2 - 2 * r**3, dt * (r**3 - r**2)
+        phi = h00 * p0 + h10 * w0 + h01 * p1 + h11 * w1 + 2 * np.pi * self.turns * laps
+        return k, phi, h00 * w0 + h10 * a0 + h01 * w1 + h11 * a1
+
+    def state(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """Configuration (m, m, rad) and rate (m/s, m/s, rad/s) at times t (s), t.shape + (3,)."""
+        k, phi, dphi = self._heading(t)
+        b, kap = self.body, self.body.c / self.body.m
+        r = (np.asarray(t, dtype=float) % self.period - self.t[k])[..., None]
+        p = b.m * self.V[k] + b.c * self.C[k]
+        C = np.exp(-kap * r) * self.C[k] - np.expm1(-kap * r) / b.c * p + self.Fw[k] * _phi2(kap * r) / (b.m * kap**2)
+        V = np.exp(-kap * r) * self.V[k] - np.expm1(-kap * r) / b.c * self.Fw[k]
+        return np.concatenate([C, phi[..., None]], -1), np.concatenate([V, dphi[..., None]], -1)
+
+    def inputs(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """F (N) and beta (rad) at times t (s), shape t.shape."""
+        k, phi, _ = self._heading(t)
+        fx, fy = self.Fw[k][..., 0], self.Fw[k][..., 1]
+        return np.hypot(fx, fy), np.angle(np.exp(1j * (np.arctan2(fy, fx) - phi)))
 
 
-@lru_cache(maxsize=16)
-def _paper_heading(body: Body, kind: str, R: float, Theta: float) -> np.ndarray:
-    """The paper's steady heading error p = phi - phi_d (rad) as complex Fourier coefficients
-    c_k (k = 0 .. HARMONICS) of p(t) = c_0 + 2 Re sum_k c_k exp(i k Theta t) (cached: the book
-    asks for it under several limits)."""
-    p = paper_steady(body, kind, R, Theta).p[:-1]
-    return np.fft.rfft(p)[:HARMONICS + 1] / len(p)
+def held_force_motion(body: Body, bound: CapBound, objective: str = "rms") -> HeldForceMotion:
+    """:func:`lib.optimal.bound.cap_bound`'s achieved motion of ``objective`` ("max" or "rms") as a
+    motion of the full model (2)-(4), its heading on the period-1 orbit that
+    :func:`lib.optimal.bound.heading_orbit` locates under the held force (RuntimeError without one).
+
+    Parameters
+    ----------
+    body : Body
+        The body the bound was computed for.
+    bound : CapBound
+        The bound.
+    objective : str
+        ``"max"`` (the largest distance's motion) or ``"rms"``.
+
+    Returns
+    -------
+    HeldForceMotion
+        The motion, with its heading orbit's multipliers and residual.
+    """
+    grid, mult, res, turns = heading_orbit(body, bound, objective)
+    rms = objective == "rms"
+    return HeldForceMotion(body=body, t=bound.t, C=bound.C_rms if rms else bound.C, V=bound.V_rms if rms else bound.V,
+                           Fw=bound.F_rms if rms else bound.F, heading=grid, multipliers=mult, residual=res,
+                           period=2 * math.pi / bound.Theta, kind=bound.kind, R=bound.R, Theta=bound.Theta,
+                           F_max=bound.F_max, turns=turns, objective=objective)
 
 
-def _fourier(coeffs: np.ndarray, Theta: float, t) -> tuple[np.ndarray, np.ndarray]:
-    """The series of :func:`_paper_heading` and its rate (rad/s) at times t (s)."""
-    k = np.arange(len(coeffs))
-    e = np.exp(1j * np.multiply.outer(np.asarray(t, dtype=float), k * Theta))
-    mult = np.where(k == 0, 1.0, 2.0)
-    return (mult * coeffs * e).sum(-1).real, (mult * 1j * k * Theta * coeffs * e).sum(-1).real
-
-
-def _path_start(body, kind, R, Theta, t_col, t_mid, heading):
-    """A start with C on the path: states at the collocation times ``t_col`` (nodes, d + 1),
-    inputs at the interval mid-times ``t_mid`` (the force w of the path, its angle to the
-    heading), the heading (phi, phi') given by ``heading(t)``."""
-    ref = make(kind, R, Theta)
-    z, dz, _ = ref.kinematics(t_col)
-    phi, dphi = heading(t_col)
-    X = np.concatenate([z[..., :2], phi[..., None], dz[..., :2], dphi[..., None]], axis=-1)
-    w, _ = _force(body, kind, R, Theta, t_mid)
-    u = np.stack([np.hypot(w[:, 0], w[:, 1]), wrap_angle(np.arctan2(w[:, 1], w[:, 0]) - heading(t_mid)[0])], -1)
-    return X, u
-
-
-def _start(name, body, kind, R, Theta, turns, t_col, t_mid, shift):
-    """The (states, inputs) of a named start (see :func:`periodic_motion`): ``"paper"`` the
-    paper's steady heading; ``"force"`` the heading along w = m C_d'' + c C_d' turned by
-    ``shift`` (rad), continuous, with a linear drift added if w's winding over a period is not
-    the path's turn n (never on the book's paths)."""
-    T = 2 * np.pi / Theta
-    ref = make(kind, R, Theta)
-    if name == "paper":
-        coeffs = _paper_heading(body, kind, R, Theta)
-
-        def heading(t):
-            p, dp = _fourier(coeffs, Theta, t)
-            zd, dzd, _ = ref.kinematics(t)
-            return zd[..., 2] + p, dzd[..., 2] + dp
-        return _path_start(body, kind, R, Theta, t_col, t_mid, heading)
-    tt = np.linspace(0.0, T, 257)
-    w, _ = _force(body, kind, R, Theta, tt)
-    ang = np.unwrap(np.arctan2(w[:, 1], w[:, 0]))
-    slip = 2 * np.pi * (turns - round((ang[-1] - ang[0]) / (2 * np.pi))) / T
-
-    def heading(t):
-        w, dw = _force(body, kind, R, Theta, t)
-        raw = np.arctan2(w[..., 1], w[..., 0])
-        near = np.interp(t, tt, ang)            # the unwrapped branch; t lies in [0, T)
-        phi = raw + 2 * np.pi * np.round((near - raw) / (2 * np.pi)) + slip * t + shift
-        rate = (w[..., 0] * dw[..., 1] - w[..., 1] * dw[..., 0]) / (w ** 2).sum(-1) + slip
-        return phi, rate
-    return _path_start(body, kind, R, Theta, t_col, t_mid, heading)
-
-
-def _guess_start(g: PeriodicMotion, t_col, t_mid):
-    z, dz = g.state(t_col)
-    F, beta = g.inputs(t_mid)
-    return np.concatenate([z, dz], -1), np.stack([F, beta], -1)
-
-
-def _bounds(tr, F_max, beta_max):
-    lo = np.full((tr.nodes, tr.block), -np.inf)
-    hi = np.full((tr.nodes, tr.block), np.inf)
-    b = FREE_ANGLE if beta_max is None else beta_max
-    lo[:, -2], hi[:, -2] = 0.0, np.inf if F_max is None else F_max
-    lo[:, -1], hi[:, -1] = -b, b
-    return lo.ravel(), hi.ravel()
-
-
-def _clip(u, F_max, beta_max):
-    b = FREE_ANGLE if beta_max is None else beta_max
-    return np.stack([np.clip(u[:, 0], 0.0, np.inf if F_max is None else F_max), np.clip(u[:, 1], -b, b)], -1)
-
-
-def _max_error(motion: PeriodicMotion, ref) -> float:
-    """Largest |C - C_d| (m): DENSE samples per interval, the largest refined by a bounded search."""
-    n = motion.nodes * DENSE
-    t = np.arange(n) * (motion.period / n)
-
-    def dist(tt):
-        return np.linalg.norm(motion.state(tt)[0][..., :2] - ref.z(tt)[..., :2], axis=-1)
-
-    d = dist(t)
-    i = int(np.argmax(d))
-    dt = motion.period / n
-    res = minimize_scalar(lambda s: -float(dist(s)), bounds=(t[i] - dt, t[i] + dt), method="bounded",
-                          options={"xatol": 1e-9 * motion.period})
-    return max(float(d[i]), -float(res.fun))
+@lru_cache(maxsize=8)
+def _convex_held(body: Body, kind: str, R: float, Theta: float, F_max: float, nodes: int) -> HeldForceMotion:
+    """The "convex" start's motion: the RMS-optimal held-force motion of the cap's convex problem
+    at ``nodes`` (at least 16) nodes (cached: the continuation and the multistart reuse it)."""
+    return held_force_motion(body, cap_bound(body, R, Theta, F_max, kind=kind, nodes=max(nodes, 16)), "rms")
 
 
 def periodic_motion(body: Body, R: float, Theta: float, *, kind: str = "eight", F_max: float | None = None,
                     beta_max: float | None = None, nodes: int = 80, degree: int = 3, guess=None,
-                    starts=STARTS) -> PeriodicMotion:
+                    starts=None, shifts=()) -> PeriodicMotion:
     """The periodic motion of the model (2)-(4) that keeps C closest to the path, in RMS.
 
     Minimises the mean of |C - C_d(t)|^2 over a period by Legendre collocation
@@ -304,8 +306,11 @@ def periodic_motion(body: Body, R: float, Theta: float, *, kind: str = "eight", 
     :func:`lib.percussion.paper_steady`, its inputs clipped into the limits); ``"force"``, C
     on the path with the heading along the force w = m C_d'' + c C_d' that keeps it there
     (beta = 0); ``"shifted"``, the same with the heading turned by +beta_max / 2 and by
-    -beta_max / 2 (two solves; +-pi/4 without an angle limit); and each motion in ``guess``,
-    interpolated onto the mesh (continuation in beta_max).
+    -beta_max / 2 (two solves; +-pi/4 without an angle limit); ``"convex"``, the optimum of
+    the cap's convex problem (:func:`lib.optimal.bound.cap_bound` at ``nodes`` nodes, its
+    RMS-optimal held world force, with the heading on its periodic orbit under that force,
+    :func:`held_force_motion`; needs ``F_max``, its beta clipped into an angle limit); and each
+    motion in ``guess``, interpolated onto the mesh (continuation in beta_max).
 
     Parameters
     ----------
@@ -325,10 +330,15 @@ def periodic_motion(body: Body, R: float, Theta: float, *, kind: str = "eight", 
         Intervals per period, 8 to :data:`MAX_NODES`.
     degree : int
         Legendre points per interval, 1 to 5 (order 2 degree at the nodes).
-    guess : PeriodicMotion or sequence of PeriodicMotion, optional
-        Earlier solutions on the same path (kind, R, Theta), used as extra starts.
-    starts : tuple of str
-        Which of :data:`STARTS` to run (may be empty when ``guess`` is given).
+    guess : PeriodicMotion, sequence or dict of PeriodicMotion, optional
+        Earlier solutions on the same path (kind, R, Theta), used as extra starts, named
+        ``guess[i]`` in ``starts`` of the result, or by their keys when given as a dict.
+    starts : tuple of str, optional
+        Which of :data:`STARTS` to run (may be empty when ``guess`` is given); default
+        ``"paper"``, ``"force"``, ``"shifted"``, and ``"convex"`` under a cap without an angle limit.
+    shifts : sequence of float
+        More starts: the ``"force"`` start with its heading turned by each angle (rad), named
+        ``"heading +12.0 deg"`` (a multi-start).
 
     Returns
     -------
@@ -344,6 +354,7 @@ def periodic_motion(body: Body, R: float, Theta: float, *, kind: str = "eight", 
     """
     R, Theta, F_max, beta_max, nodes, degree, guesses, starts = _check_args(
         body, R, Theta, kind, F_max, beta_max, nodes, degree, guess, starts)
+    shifts = [float(d) for d in checks.array("shifts", shifts, ndim=1)]
     turns = heading_turns(make(kind, R, Theta))
     T = 2 * np.pi / Theta
     h = T / nodes
@@ -355,12 +366,16 @@ def periodic_motion(body: Body, R: float, Theta: float, *, kind: str = "eight", 
     Cd = ref.z(t_col[:, 1:])[..., :2]
     tr = transcription(body, nodes, degree)
     sh = FREE_SHIFT if beta_max is None else beta_max / 2
-    named = [(s, s, 0.0) for s in starts if s != "shifted"]
+    named = [(s, s, 0.0) for s in starts if s not in ("shifted", "convex")]
     if "shifted" in starts:
         named += [("shifted+", "force", sh), ("shifted-", "force", -sh)]
     jobs = [(name, lambda s=src, d=dsh: _start(s, body, kind, R, Theta, turns, t_col, t_mid, d))
             for name, src, dsh in named]
-    jobs += [(f"guess[{i}]", lambda g=g: _guess_start(g, t_col, t_mid)) for i, g in enumerate(guesses)]
+    jobs += [(f"heading {math.degrees(d):+.1f} deg", lambda d=d: _start("force", body, kind, R, Theta, turns, t_col,
+                                                                         t_mid, d)) for d in shifts]
+    if "convex" in starts:
+        jobs.append(("convex", lambda: _guess_start(_convex_held(body, kind, R, Theta, F_max, nodes), t_col, t_mid)))
+    jobs += [(name, lambda g=g: _guess_start(g, t_col, t_mid)) for name, g in guesses]
     par = np.concatenate([[h, 2 * np.pi * turns], Cd.ravel()])
     Xs, u, table = _best(tr, jobs, par, F_max, beta_max)
     e2 = ((Xs[:, 1:, :2] - Cd) ** 2).sum(-1)
@@ -390,7 +405,7 @@ def _check_args(body, R, Theta, kind, F_max, beta_max, nodes, degree, guess, sta
     if degree > 5:
         raise ValueError(f"degree must be at most 5, got {degree}")
     guesses = _check_guess(guess, kind, R, Theta)
-    return R, Theta, F_max, beta_max, nodes, degree, guesses, _check_starts(starts, guesses)
+    return R, Theta, F_max, beta_max, nodes, degree, guesses, _check_starts(starts, guesses, F_max, beta_max)
 
 
 def _best(tr, jobs, par, F_max, beta_max) -> tuple[np.ndarray, np.ndarray, tuple]:
@@ -402,7 +417,7 @@ def _best(tr, jobs, par, F_max, beta_max) -> tuple[np.ndarray, np.ndarray, tuple
     for name, make_start in jobs:
         try:
             X, u = make_start()
-        except ValueError as exc:
+        except (ValueError, RuntimeError) as exc:
             table.append((name, math.nan, f"no start: {exc}"))
             continue
         sol = tr.solver(x0=tr.pack(X, _clip(u, F_max, beta_max)), lbx=lbx, ubx=ubx, lbg=0.0, ubg=0.0, p=par)
@@ -418,13 +433,34 @@ def _best(tr, jobs, par, F_max, beta_max) -> tuple[np.ndarray, np.ndarray, tuple
     return X, u, tuple(table)
 
 
+def _return_mismatch(body: Body, motion: PeriodicMotion, rtol, atol) -> np.ndarray:
+    """X(T) - X(0) - (0, 0, 2 pi n, 0, 0, 0) (6,) of a motion's inputs integrated over one period."""
+    checks.instance("body", body, Body)
+    checks.instance("motion", motion, PeriodicMotion)
+    rtol = checks.number("rtol", rtol, positive=True)
+    atol = checks.number("atol", atol, positive=True)
+    z0, dz0 = motion.state(0.0)
+    q = state_from_config(z0, dz0)
+    h = motion.period / motion.nodes
+    for k in range(motion.nodes):
+        F, beta = float(motion.F[k]), float(motion.beta[k])
+        _, qs = simulate_open_loop(body, lambda t, F=F: F, lambda t, b=beta: b, q, h, form="config",
+                                   t_eval=np.array([h]), rtol=rtol, atol=atol)
+        q = qs[-1]
+    z1, dz1 = config_from_state(q)
+    X1 = np.concatenate([z1, dz1]) - np.concatenate([z0, dz0])
+    X1[2] -= 2 * np.pi * motion.turns
+    return X1
+
+
 def verify_motion(body: Body, motion: PeriodicMotion, *, rtol: float = 1e-10, atol: float = 1e-10) -> float:
     """The return error of a motion's inputs integrated by the book's integrator.
 
     Integrates the model (2)-(4) (:func:`lib.simulate.simulate_open_loop`, ``form="config"``)
     under ``motion.inputs`` from ``motion.state(0)`` over one period, interval by interval
     (each interval's inputs are constant, so the integrator never steps across a jump), and
-    returns max |X(T) - X(0) - (0, 0, 2 pi n, 0, 0, 0)| over the six state components.
+    returns max |X(T) - X(0) - (0, 0, 2 pi n, 0, 0, 0)| over the six state components
+    (:func:`return_errors` gives it per quantity, each in its unit).
 
     Parameters
     ----------
@@ -441,20 +477,23 @@ def verify_motion(body: Body, motion: PeriodicMotion, *, rtol: float = 1e-10, at
         The return error, a max-norm over components in the state's own units (m, m, rad,
         m/s, m/s, rad/s), not a physical length.
     """
-    checks.instance("body", body, Body)
-    checks.instance("motion", motion, PeriodicMotion)
-    rtol = checks.number("rtol", rtol, positive=True)
-    atol = checks.number("atol", atol, positive=True)
-    z0, dz0 = motion.state(0.0)
-    q = state_from_config(z0, dz0)
-    h = motion.period / motion.nodes
-    for k in range(motion.nodes):
-        F, beta = float(motion.F[k]), float(motion.beta[k])
-        _, qs = simulate_open_loop(body, lambda t, F=F: F, lambda t, b=beta: b, q, h, form="config",
-                                   t_eval=np.array([h]), rtol=rtol, atol=atol)
-        q = qs[-1]
-    z1, dz1 = config_from_state(q)
-    X0 = np.concatenate([z0, dz0])
-    X1 = np.concatenate([z1, dz1])
-    X1[2] -= 2 * np.pi * motion.turns
-    return float(np.max(np.abs(X1 - X0)))
+    return float(np.max(np.abs(_return_mismatch(body, motion, rtol, atol))))
+
+
+def return_errors(body: Body, motion: PeriodicMotion, *, rtol: float = 1e-10, atol: float = 1e-10) -> dict:
+    """:func:`verify_motion`'s mismatch after one period, per quantity, each in its own unit.
+
+    Parameters
+    ----------
+    body, motion, rtol, atol
+        As in :func:`verify_motion`.
+
+    Returns
+    -------
+    dict
+        ``position`` |dC| (m), ``heading`` |d phi| (rad), ``velocity`` |dC'| (m/s), ``rate``
+        |d phi'| (rad/s).
+    """
+    d = _return_mismatch(body, motion, rtol, atol)
+    return dict(position=float(np.hypot(d[0], d[1])), heading=float(abs(d[2])),
+                velocity=float(np.hypot(d[3], d[4])), rate=float(abs(d[5])))

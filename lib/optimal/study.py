@@ -1,8 +1,9 @@
 """Chapter 8's computations, each one call that the chapter and the report share (through
 :func:`lib.machinery.cache.cached`, with the same arguments): the bound under a force cap over
-caps and meshes (:func:`cap_sweep`, :func:`cap_convergence`), the best periodic motions under
-the angle limits by continuation (:func:`limit_motions`) and their mesh study
-(:func:`motion_convergence`).
+caps and meshes (:func:`cap_sweep`, :func:`cap_convergence`), the best periodic motions found under
+the angle limits by continuation from the cap's own optimum (:func:`limit_motions`), their
+mesh study (:func:`motion_convergence`) and a multi-start study of one setting
+(:func:`multistart`).
 """
 
 from __future__ import annotations
@@ -15,10 +16,12 @@ import pandas as pd
 from ..machinery import checks
 from ..params import Body
 from .bound import cap_bound, exact_peak_force
-from .motion import PeriodicMotion, periodic_motion, verify_motion
+from .collocation import ACCEPTED
+from .motion import START_TIE, PeriodicMotion, periodic_motion, return_errors
 
-__all__ = ["PAPER_CAP", "CHAPTER_ANGLES_DEG", "SETTINGS", "setting_label", "cap_sweep", "cap_convergence",
-           "limit_motions", "motion_convergence", "convergence_table", "motions_table", "mesh_table"]
+__all__ = ["PAPER_CAP", "CHAPTER_ANGLES_DEG", "SETTINGS", "CAP_REFINED", "MULTISTART_SEED", "setting_label",
+           "cap_sweep", "cap_convergence", "limit_motions", "motion_convergence", "multistart", "convergence_table",
+           "motions_table", "mesh_table", "multistart_summary"]
 
 #: the paper's force cap (N), Fig. 4
 PAPER_CAP = 4.0
@@ -27,6 +30,12 @@ CHAPTER_ANGLES_DEG = (90, 60, 45, 30)
 #: the limit settings of Chapter 8's comparison; (angle limit (deg) or None, cap (N) or None)
 SETTINGS = ((None, PAPER_CAP),) + tuple((a, None) for a in CHAPTER_ANGLES_DEG[::-1]) \
     + tuple((a, PAPER_CAP) for a in CHAPTER_ANGLES_DEG[::-1])
+#: the meshes (intervals a period) the cap-alone optimum is refined through after the default one:
+#: its inputs are held in the body's frame while the heading swings within an interval, so its RMS
+#: error falls as h^2 towards the convex optimum (at 320 within the bound's bracket at 80 nodes)
+CAP_REFINED = (160, 320)
+#: the seed of :func:`multistart`'s random headings
+MULTISTART_SEED = 20141
 
 
 def setting_label(angle_deg, cap) -> str:
@@ -114,12 +123,16 @@ def cap_convergence(body: Body, R: float, Theta: float, F_max: float, nodes=(64,
 
 
 def limit_motions(body: Body, R: float, Theta: float, *, kind: str = "eight", angles_deg=CHAPTER_ANGLES_DEG,
-                  caps=(None, PAPER_CAP), nodes: int = 80) -> dict:
+                  caps=(None, PAPER_CAP), nodes: int = 80, refine=CAP_REFINED) -> dict:
     """The best periodic motions found (:func:`lib.optimal.motion.periodic_motion`) at every
     setting: for each cap (N, or None) the angle limits in the given order, each started from its
-    own starts and from the motion of the limit before (continuation: the largest limit first, so
-    that each smaller one starts from a motion just outside its set); with a cap, also the cap
-    alone (key (None, cap)).
+    own starts and from the best found at the limit before (continuation: the largest limit first,
+    so that each smaller one starts from a motion just outside its set); with a cap, the first
+    angle limit also from the cap alone's optimum (itself from every start, the convex one
+    included), which is refined through the meshes ``refine`` (each from the one before, as
+    :func:`motion_convergence`) and kept at the finest under the key (None, cap). Each motion's
+    ``best_start`` names the start that won (``"from 4 N"``, ``"from 90 deg + 4 N"`` for the
+    continuation).
 
     Returns
     -------
@@ -129,26 +142,90 @@ def limit_motions(body: Body, R: float, Theta: float, *, kind: str = "eight", an
     R, Theta = _check(body, R, Theta, kind)
     angles = [checks.number("angles_deg", a, positive=True, maximum=180.0) for a in angles_deg]
     caps = [None if c is None else checks.number("caps", c, positive=True, unit="N") for c in caps]
-    checks.integer("nodes", nodes, minimum=8)
+    nodes = checks.integer("nodes", nodes, minimum=8)
+    refine = [checks.integer("refine", n, minimum=nodes + 1) for n in refine]
     out: dict = {}
     for cap in caps:
-        if cap is not None:
-            out[(None, cap)] = periodic_motion(body, R, Theta, kind=kind, F_max=cap, nodes=nodes)
         guess = None
+        if cap is not None:
+            m = periodic_motion(body, R, Theta, kind=kind, F_max=cap, nodes=nodes)
+            guess = {f"from {setting_label(None, cap)}": m}
+            for n in refine:
+                m = periodic_motion(body, R, Theta, kind=kind, F_max=cap, nodes=n, starts=(), guess={
+                    f"from {m.nodes} intervals": m})
+            out[(None, cap)] = m
         for a in angles:
             m = periodic_motion(body, R, Theta, kind=kind, F_max=cap, beta_max=math.radians(a), nodes=nodes,
                                 guess=guess)
-            out[(int(a) if float(a).is_integer() else a, cap)] = m
-            guess = m
+            key = (int(a) if float(a).is_integer() else a, cap)
+            out[key] = m
+            guess = {f"from {setting_label(*key)}": m}
     return out
+
+
+def multistart(body: Body, R: float, Theta: float, beta_max: float, F_max: float | None, *, n_random: int = 16,
+               seed: int = MULTISTART_SEED, nodes: int = 80, kind: str = "eight") -> pd.DataFrame:
+    """The local optima that the collocation (:func:`lib.optimal.motion.periodic_motion`) reaches
+    from many starts at one setting: the named starts (``"paper"``, ``"force"``,
+    ``"shifted+-"``, and ``"convex"`` under a cap) and ``n_random`` headings turned by angles
+    drawn uniformly in [-pi, pi) by ``numpy.random.default_rng(seed)``.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    R, Theta : float
+        The path (m, rad/s).
+    beta_max : float
+        Angle limit (rad).
+    F_max : float or None
+        Force cap (N); None for none.
+    n_random : int
+        Random headings, >= 1.
+    seed : int
+        The generator's seed.
+    nodes : int
+        Intervals a period.
+    kind : str
+        ``"eight"`` or ``"circle"``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row a start: start (its name), rms_error (m; NaN if IPOPT did not converge), converged.
+    """
+    R, Theta = _check(body, R, Theta, kind)
+    n_random = checks.integer("n_random", n_random, minimum=1)
+    seed = checks.integer("seed", seed, minimum=0)
+    shifts = np.random.default_rng(seed).uniform(-math.pi, math.pi, n_random)
+    named = ("paper", "force", "shifted") + (() if F_max is None else ("convex",))
+    m = periodic_motion(body, R, Theta, kind=kind, F_max=F_max, beta_max=beta_max, nodes=nodes, starts=named,
+                        shifts=shifts)
+    return pd.DataFrame([dict(start=name, rms_error=rms, converged=status in ACCEPTED)
+                         for name, rms, status in m.starts])
+
+
+def multistart_summary(frame: pd.DataFrame, tol: float = 1e-4) -> dict:
+    """:func:`multistart`'s spread: starts, converged, best and worst RMS (m) over the converged
+    ones, and how many lie within ``tol`` (m) of the best.
+
+    Returns
+    -------
+    dict
+        starts, converged, best, worst, near_best.
+    """
+    ok = frame.rms_error[frame.converged.astype(bool)]
+    best = float(ok.min())
+    return dict(starts=len(frame), converged=len(ok), best=best, worst=float(ok.max()),
+                near_best=int((ok <= best + tol).sum()))
 
 
 def motion_convergence(body: Body, R: float, Theta: float, beta_max: float, F_max: float | None,
                        nodes=(40, 80, 160), *, kind: str = "eight") -> pd.DataFrame:
     """The best motion under (beta_max (rad), F_max (N or None)) against the mesh: its RMS and
     largest distance (m), its peak force (N), and the return error of its inputs integrated by
-    the book's integrator over one period (:func:`lib.optimal.motion.verify_motion`, the
-    max-norm of the state's mismatch: m, rad, m/s, rad/s).
+    the book's integrator over one period, per quantity (:func:`lib.optimal.motion.return_errors`:
+    position (m), heading (rad), velocity (m/s), rate (rad/s)).
 
     Mesh refinement of one optimum: the coarsest mesh is solved from every start of
     :func:`lib.optimal.motion.periodic_motion`, each finer one from the optimum of the mesh
@@ -173,7 +250,8 @@ def motion_convergence(body: Body, R: float, Theta: float, beta_max: float, F_ma
     Returns
     -------
     pandas.DataFrame
-        Columns nodes, rms_error, max_error, F_peak, return_error.
+        Columns nodes, rms_error, max_error, F_peak, return_position (m), return_heading (rad),
+        return_velocity (m/s), return_rate (rad/s).
     """
     R, Theta = _check(body, R, Theta, kind)
     meshes = [checks.integer("nodes", n, minimum=8) for n in np.atleast_1d(nodes)]
@@ -184,7 +262,7 @@ def motion_convergence(body: Body, R: float, Theta: float, beta_max: float, F_ma
         opts = {} if m is None else dict(starts=(), guess=m)
         m = periodic_motion(body, R, Theta, kind=kind, F_max=F_max, beta_max=beta_max, nodes=n, **opts)
         rows.append(dict(nodes=n, rms_error=m.rms_error, max_error=m.max_error, F_peak=float(m.F.max()),
-                         return_error=verify_motion(body, m)))
+                         **{f"return_{q}": e for q, e in return_errors(body, m).items()}))
     return pd.DataFrame(rows)
 
 
@@ -210,8 +288,9 @@ def convergence_table(conv: pd.DataFrame) -> pd.DataFrame:
 
 
 def motions_table(motions: dict) -> pd.DataFrame:
-    """The best motions of :func:`limit_motions` under the angle limits: angle limit (deg), cap,
-    RMS and largest distance (m), peak force (N).
+    """The best motions found by :func:`limit_motions` under the angle limits: angle limit (deg),
+    cap, RMS and largest distance (m, four decimals), peak force (N, two), the start that won and
+    how many of the starts end within :data:`lib.optimal.motion.START_TIE` of it.
 
     Parameters
     ----------
@@ -224,14 +303,17 @@ def motions_table(motions: dict) -> pd.DataFrame:
         One row a motion with an angle limit, formatted.
     """
     rows = [{"angle limit (deg)": a, "cap (N)": "none" if c is None else f"{c:g}",
-             "RMS distance (m)": f"{m.rms_error:.3g}", "largest (m)": f"{m.max_error:.3g}",
-             "peak F (N)": f"{float(m.F.max()):.2f}"} for (a, c), m in motions.items() if a is not None]
+             "RMS distance (m)": f"{m.rms_error:.4f}", "largest (m)": f"{m.max_error:.4f}",
+             "peak F (N)": f"{float(m.F.max()):.2f}", "best start": m.best_start,
+             "starts at it": f"{sum(r <= m.rms_error + START_TIE for _, r, _ in m.starts)} of {len(m.starts)}"}
+            for (a, c), m in motions.items() if a is not None]
     return pd.DataFrame(rows)
 
 
 def mesh_table(conv: dict) -> pd.DataFrame:
     """:func:`motion_convergence`'s frames by cap, as the page shows them: cap, intervals, RMS
-    distance (m), peak force (N), return error (the state's max-norm mismatch).
+    distance (m), peak force (N), and the return error per quantity: position (m), heading (rad),
+    velocity (m/s), rate (rad/s).
 
     Parameters
     ----------
@@ -246,5 +328,7 @@ def mesh_table(conv: dict) -> pd.DataFrame:
     return pd.concat([pd.DataFrame({"cap": "none" if c is None else f"{c:g} N", "intervals": f.nodes,
                                     "RMS distance (m)": f.rms_error.map("{:.4f}".format),
                                     "peak F (N)": f.F_peak.map("{:.2f}".format),
-                                    "return error": f.return_error.map("{:.1e}".format)})
+                                    **{f"return, {q} ({u})": f[f"return_{q}"].map("{:.0e}".format)
+                                       for q, u in (("position", "m"), ("heading", "rad"), ("velocity", "m/s"),
+                                                    ("rate", "rad/s"))}})
                       for c, f in conv.items()], ignore_index=True)
