@@ -78,10 +78,11 @@ def test_a_malformed_number_is_refused_naming_what_is_wrong(bad, match):
 # ----------------------------------------------------------------- the words before a number
 
 #: words that make the number after them a floor ("at least x": x must not exceed the value)
-FLOOR_WORDS = ("at least", "no less than", "not below", "no closer than", "closer to the eight than",
-               "lower bound of")
-#: words that make it a ceiling ("at most x": x must not fall below the value)
-CEILING_WORDS = ("at most", "up to", "no more than", "below", "under", "within", "less than")
+FLOOR_WORDS = ("at least", "no less than", "no closer than", "closer to the eight than")
+#: words that make it a ceiling ("at most x": x must not fall below the value). "up to", "below" and
+#: "under" are not read: they also state a range ("held up to w = x", "below x it holds"), where
+#: the safe side is the other one; such a number is glued with its kind (lower_bound, upper_bound)
+CEILING_WORDS = ("at most", "no more than", "within")
 GLUE_TEXT = re.compile(r"\{glue:text\}`(?:[^`:]+::)?([A-Za-z0-9_]+)(?::([^`]*))?`")
 
 
@@ -105,6 +106,7 @@ def test_the_words_before_a_number_are_read_as_a_floor_or_a_ceiling():
     assert reading("and c ends at least ") == "floor"
     assert reading("multipliers of modulus at most ") == "ceiling"
     assert reading("the ratio reaches ") is None
+    assert reading("the circle is held up to ") is None          # a range: its safe side is below
 
 
 def rendered(text_plain: str, fmt: str | None) -> str:
