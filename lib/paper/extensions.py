@@ -315,9 +315,11 @@ def _check_optimal_tracker() -> Outcome:
                     for r in opt.itertuples()))
     ok = bool((opt.regime == "periodic").all()) and rho < 1.0 and gap < 1e-3      # measured 3e-4 m
     return Outcome(legend_status(ok, extension=True), rho,
-                   "largest |Floquet multiplier| of the periodic LQR's orbits about the best motions, every setting",
+                   "largest |Floquet multiplier| of the periodic LQR's orbits about the best motions found, every "
+                   "setting",
                    f"decided on the clipped loop's period map (Newton, multipliers, reach test) at {len(opt)} "
-                   f"settings: periodic at each, its RMS error within {gap:.0e} m of the planned motion's; the "
+                   f"settings: periodic at each, its RMS error within {upper_bound(gap, '.0e').text()} m of the "
+                   "planned motion's; the "
                    f"paper's start reaches it at {int(opt.paper_start_reached.sum())} of them")
 
 
