@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: book test test-portable benchmark book-times clean mutation
+.PHONY: book test test-portable chapter pdf benchmark book-times clean mutation
 
 $(STAMP): requirements.txt pyproject.toml
 	@echo "Installing .venv from requirements.txt and pyproject.toml (a few minutes the first time)..."
@@ -26,6 +26,25 @@ book: $(STAMP)
 	touch -r _build/build.start _build/build.log
 	@test "$$(cat _build/build.rc)" = 0 || { echo "Book build failed (see _build/build.log)"; exit 1; }
 	@echo "Book built: $(CURDIR)/_build/html/index.html"
+
+# One page at a time: `make chapter CH=08` (a chapter's number, or a page: CH=report, intro,
+# errata, methods) executes that page alone into the execution cache, keeping every other page's
+# entry there (tools/preexecute.py --keep-cache), then builds the HTML again, reading every page's
+# outputs from the cache. The pages that quote a chapter's results (the report, the errata, the
+# front page) keep what the cache holds for them until they are executed again themselves.
+chapter: $(STAMP)
+	@test -n "$(CH)" || { echo "usage: make chapter CH=08 (a chapter's number, or CH=report, intro, errata, methods)"; exit 2; }
+	mkdir -p _build
+	PYTHONWARNINGS=default $(BIN)/python tools/preexecute.py --keep-cache --jobs 1 $(CH)
+	$(BIN)/jupyter-book build --all -n --keep-going .
+
+# The whole book as one PDF, _build/pdf/book.pdf (tools/pdf.py): the single-page HTML build,
+# which reads every page's outputs from the execution cache (`make book` fills it first when
+# it is missing), printed by headless Chromium once MathJax has typeset the math, each
+# interactive figure as a static image. Needs Debian's chromium (.ci/run installs it).
+pdf: $(STAMP)
+	@test -d _build/.jupyter_cache || $(MAKE) --no-print-directory book
+	$(BIN)/python tools/pdf.py
 
 # The book's build runs in the background (as `make book` runs it, its output in _build/book.out)
 # while the other tests run on two workers (pytest-xdist); then the build and browser tests read

@@ -15,6 +15,10 @@ reused: the cache is emptied first, and a page that fails stops
 the script with its traceback (the build is then not run). Pages that read other pages' results
 (``LAST``: the report, the errata and the front page's findings read the chapters' through :mod:`lib.machinery.cache`) start
 last; the others start longest first (``COST``, measured by ``benchmarks/book_times.py``).
+
+One page at a time (``make chapter CH=08``): ``--keep-cache`` with the pages named executes only
+those and replaces their entries; the cache is not emptied, so the build that follows reads every
+other page's outputs from it as an earlier build left them.
 """
 
 from __future__ import annotations
@@ -106,6 +110,32 @@ def notebook_pages(root: Path = ROOT) -> list[str]:
             and is_myst_markdown_notebook((root / f"{p}.md").read_text())]
 
 
+def resolve_page(name: str, root: Path = ROOT) -> str:
+    """The notebook page ``name`` stands for: a page as in ``_toc.yml`` (``chapters/08_optimal``,
+    ``report``, with or without ``.md``), or a chapter's number (``08`` or ``8``).
+
+    Parameters
+    ----------
+    name : str
+        What ``make chapter CH=...`` was given.
+    root : pathlib.Path
+        The book's folder.
+
+    Returns
+    -------
+    str
+        The page, without suffix.
+    """
+    pages = notebook_pages(root)
+    page = name.removesuffix(".md")
+    if page.isdigit():
+        page = next((p for p in pages if p.startswith(f"chapters/{int(page):02d}_")), page)
+    if page not in pages:
+        raise ValueError(f"page {name!r} is not a notebook page of _toc.yml; give a chapter's number "
+                         f"(01 to 08) or one of: {', '.join(p for p in pages if '/' not in p)}")
+    return page
+
+
 def read_page(md: Path, root: Path = ROOT):
     """The page as the build reads it: myst-nb's reader with the book's MyST extensions."""
     from myst_nb.core.read import read_myst_markdown_notebook
@@ -150,7 +180,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--jobs", type=int, default=int(os.environ.get("BOOK_JOBS", "2")),
                     help="pages executed at once (default 2, or $BOOK_JOBS)")
     ap.add_argument("--root", type=Path, default=ROOT, help="the book's folder")
-    ap.add_argument("pages", nargs="*", help="only these pages (default: every notebook page of _toc.yml)")
+    ap.add_argument("--keep-cache", action="store_true",
+                    help="keep the cache's other pages and replace only these pages' entries "
+                         "(make chapter); without it the cache is emptied first")
+    ap.add_argument("pages", nargs="*", help="only these pages (default: every notebook page of _toc.yml): "
+                    "as in _toc.yml (chapters/08_optimal, report) or a chapter's number (08)")
     args = ap.parse_args(argv)
     from jupyter_cache import get_cache
     from jupyter_cache.base import CacheBundleIn
@@ -159,9 +193,16 @@ def main(argv: list[str] | None = None) -> int:
     os.environ.update(kernel_env(args.jobs))              # inherited by the workers' kernels
     execute = _config(root).get("execute", {})
     path = root / execute.get("cache", "_build/.jupyter_cache")
-    shutil.rmtree(path, ignore_errors=True)               # nothing from an earlier build
+    try:
+        wanted = [resolve_page(p, root) for p in args.pages]
+    except ValueError as e:
+        ap.error(str(e))
+    if args.keep_cache and not wanted:
+        ap.error("--keep-cache needs the pages to execute (the others are read from the cache)")
+    if not args.keep_cache:
+        shutil.rmtree(path, ignore_errors=True)           # nothing from an earlier build
     cache = get_cache(path)
-    pages = order([p for p in notebook_pages(root) if not args.pages or p in args.pages])
+    pages = order([p for p in notebook_pages(root) if not wanted or p in wanted])
     timeout, allow = int(execute.get("timeout", 30)), bool(execute.get("allow_errors", False))
     print(f"Executing {len(pages)} pages, {args.jobs} at a time, into {path.relative_to(root)}", flush=True)
     tic, failed = time.perf_counter(), []

@@ -1,0 +1,246 @@
+"""The whole book as one PDF (``make pdf``): the single-page HTML build printed by headless Chromium.
+
+Two steps:
+
+1. ``jupyter-book build --builder singlehtml .`` writes the book as one HTML page into
+   ``_build/singlehtml``. It reads every notebook page's outputs from the execution cache that
+   ``make book`` filled (``execute_notebooks: cache`` in ``_config.yml``); a page missing from
+   that cache is executed by this build, one after another, as a bare ``jupyter-book build``
+   would. The cache is neither emptied nor rebuilt here.
+2. Debian's ``chromium``, driven by Playwright with the browser test's offline flags, opens that
+   page from a server on the loopback address, waits until MathJax has typeset the math and every
+   image has loaded, replaces each interactive plotly figure (:mod:`lib.figures.interactive`) by a
+   PNG of itself (``Plotly.toImage``: the static image a printed page needs, and one that
+   ``pdfimages`` counts), and prints the page to A4 with page numbers.
+
+Output: ``_build/pdf/book.pdf`` (``--out``), and beside it ``figures.json``, how many figures
+the printed HTML held (images and interactive figures), which ``tests/test_pdf.py`` compares with
+the images of the PDF. ``--no-build`` prints the existing ``_build/singlehtml`` again.
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import http.server
+import json
+import shutil
+import subprocess
+import sys
+import threading
+import time
+from contextlib import contextmanager
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+#: the single-page build and the PDF, under a book's folder
+SINGLE_DIR = Path("_build") / "singlehtml"
+OUT_FILE = Path("_build") / "pdf" / "book.pdf"
+SINGLE, OUT = ROOT / SINGLE_DIR, ROOT / OUT_FILE
+CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+#: the browser test's launch flags (tests/test_browser.py): no sandbox (root), no GPU, nothing
+#: that reaches for a network
+CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+#: the window the page is laid out in before printing: the printed column is the theme's print
+#: layout at this width, scaled by SCALE onto the A4 page
+VIEWPORT = {"width": 1100, "height": 1400}
+SCALE = 0.72
+MARGIN = {"top": "15mm", "bottom": "15mm", "left": "14mm", "right": "14mm"}
+FOOTER = ('<div style="font-size:8px;width:100%;text-align:center;color:#555">'
+          '<span class="pageNumber"></span> / <span class="totalPages"></span></div>')
+
+#: each interactive figure replaced by a PNG of itself, at its laid-out size, twice the pixels;
+#: its modebar (zoom buttons) is not drawn by toImage. Returns how many were replaced.
+STATIC_PLOTLY = """async () => {
+  const divs = Array.from(document.querySelectorAll('.plotly-graph-div'));
+  for (const gd of divs) {
+    const w = Math.round(gd.getBoundingClientRect().width) || 700;
+    const h = Math.round(gd.getBoundingClientRect().height) || 450;
+    const url = await Plotly.toImage(gd, {format: 'png', width: w, height: h, scale: 2});
+    const img = document.createElement('img');
+    img.src = url;
+    img.style.width = w + 'px';
+    img.style.maxWidth = '100%';
+    img.className = 'plotly-static';
+    const wrap = gd.closest('.interactive-figure');
+    img.alt = wrap ? wrap.getAttribute('aria-label') : 'interactive figure';
+    Plotly.purge(gd);
+    gd.replaceWith(img);
+  }
+  await Promise.all(Array.from(document.images).map(i => i.complete ? null : i.decode().catch(() => null)));
+  return divs.length;
+}"""
+
+#: the figures the printed page holds: every image in the book's content (the matplotlib figures,
+#: the interactive figures' PNGs) and the figure environments they sit in
+COUNT_FIGURES = """() => {
+  const main = document.querySelector('main') || document.body;
+  const imgs = Array.from(main.querySelectorAll('img')).filter(i => i.naturalWidth > 0);
+  return {images: imgs.length,
+          broken: Array.from(main.querySelectorAll('img')).filter(i => !i.naturalWidth).map(i => i.src),
+          figures: main.querySelectorAll('figure').length,
+          math: document.querySelectorAll('mjx-container').length,
+          rawMath: (main.innerText.match(/\\\\\\(|\\\\\\[|\\$\\$/g) || []).length};
+}"""
+
+#: for print: the theme's navigation hidden, the content the full width; each page of the book
+#: (a ``document-`` anchor before its section) starts a printed page; figures, formulas and table
+#: rows are not split; shadows, which Chromium prints as raster images, are dropped; an
+#: animation prints its first frame without its controls; folded blocks (hidden inputs) stay folded
+PRINT_CSS = """
+@media print {
+  .bd-header, .bd-sidebar-primary, .bd-sidebar-secondary, .bd-footer, .bd-footer-content,
+  .header-article, .prev-next-area, .headerlink, .toggle-button, #pst-back-to-top,
+  .anim-controls { display: none !important; }
+  .bd-main .bd-content .bd-article-container, .bd-page-width { max-width: 100% !important; }
+  span[id^="document-"] + section { break-before: page; }
+  figure, img, .plotly-static, tr, mjx-container[display="true"] { break-inside: avoid; }
+  h1, h2, h3, h4 { break-after: avoid; }
+  /* :not(#id) weighs as an id: above the theme's own !important shadows on classes */
+  body *:not(#no-such-id) { box-shadow: none !important; text-shadow: none !important; }
+}
+"""
+
+
+def build_singlehtml(root: Path, log: Path) -> int:
+    """Run ``jupyter-book build --builder singlehtml --keep-going .`` in ``root``; its output
+    to ``log``.
+
+    Parameters
+    ----------
+    root : pathlib.Path
+        The book's folder.
+    log : pathlib.Path
+        Where the build's output is written.
+
+    Returns
+    -------
+    int
+        The build's exit status.
+    """
+    exe = Path(sys.executable).with_name("jupyter-book")
+    log.parent.mkdir(parents=True, exist_ok=True)
+    with open(log, "w") as out:
+        proc = subprocess.run([str(exe), "build", "--builder", "singlehtml", "--keep-going", "."],
+                              cwd=root, stdout=out, stderr=subprocess.STDOUT, text=True)
+    return proc.returncode
+
+
+def root_page(root: Path) -> str:
+    """The root page of the book's ``_toc.yml`` (``intro``): the single-page build writes the
+    whole book into ``<root page>.html`` (its ``index.html`` only redirects there).
+
+    Parameters
+    ----------
+    root : pathlib.Path
+        The book's folder.
+
+    Returns
+    -------
+    str
+        The page's name, without suffix.
+    """
+    import yaml
+
+    return str(yaml.safe_load((root / "_toc.yml").read_text())["root"]).removesuffix(".md")
+
+
+class _QuietHandler(http.server.SimpleHTTPRequestHandler):
+    def log_message(self, *args) -> None:
+        pass
+
+
+@contextmanager
+def _serve(folder: Path):
+    """A server for ``folder`` on the loopback address, for as long as the block runs."""
+    handler = functools.partial(_QuietHandler, directory=str(folder))
+    httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    thread = threading.Thread(target=httpd.serve_forever, daemon=True)
+    thread.start()
+    try:
+        yield f"http://127.0.0.1:{httpd.server_address[1]}"
+    finally:
+        httpd.shutdown()
+
+
+def print_pdf(html_dir: Path, out: Path, page_name: str = "intro") -> dict:
+    """Print ``html_dir/<page_name>.html`` to ``out`` in headless Chromium, once MathJax has
+    typeset and every image loaded, each interactive figure replaced by a PNG of itself.
+
+    Parameters
+    ----------
+    html_dir : pathlib.Path
+        The single-page build (``_build/singlehtml``).
+    out : pathlib.Path
+        The PDF to write.
+    page_name : str
+        The book's root page (:func:`root_page`), which holds the whole book.
+
+    Returns
+    -------
+    dict
+        What the printed page held: ``images``, ``figures``, ``interactive`` (replaced by PNGs),
+        ``math`` (typeset formulas), ``broken`` (images that did not load), ``requests`` (URLs
+        asked for off the loopback address, which must be none).
+    """
+    from playwright.sync_api import sync_playwright
+
+    if not Path(CHROMIUM).exists():
+        raise FileNotFoundError(f"Debian's chromium is not installed ({CHROMIUM}): apt-get install chromium")
+    index = html_dir / f"{page_name}.html"
+    if not index.is_file():
+        raise FileNotFoundError(f"no single-page build at {index}: run without --no-build")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    outside: list[str] = []
+    with _serve(html_dir) as url, sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS)
+        page = browser.new_context(viewport=VIEWPORT).new_page()
+        page.on("request", lambda r: None if r.url.startswith(("http://127.0.0.1", "data:", "blob:"))
+                else outside.append(r.url))
+        page.goto(f"{url}/{index.name}", wait_until="networkidle", timeout=300_000)
+        page.wait_for_function("() => !!(window.MathJax && MathJax.startup && MathJax.startup.promise)",
+                               timeout=120_000)
+        page.evaluate("() => MathJax.startup.promise")
+        page.wait_for_function("() => Array.from(document.images).every(i => i.complete)", timeout=120_000)
+        interactive = page.evaluate(STATIC_PLOTLY)
+        page.add_style_tag(content=PRINT_CSS)
+        page.emulate_media(media="print")
+        held = page.evaluate(COUNT_FIGURES)
+        page.pdf(path=str(out), format="A4", print_background=True, margin=MARGIN, scale=SCALE,
+                 display_header_footer=True, header_template="<span></span>", footer_template=FOOTER)
+        browser.close()
+    return {**held, "interactive": interactive, "requests": outside}
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--root", type=Path, default=ROOT, help="the book's folder (default: this checkout)")
+    ap.add_argument("--out", type=Path, help=f"the PDF (default {OUT_FILE} under the book's folder)")
+    ap.add_argument("--no-build", action="store_true", help="print the existing _build/singlehtml again")
+    args = ap.parse_args(argv)
+    root = args.root.resolve()
+    out = (args.out or root / OUT_FILE).resolve()
+    tic = time.perf_counter()
+    if not args.no_build:
+        log = out.parent / "singlehtml.log"
+        print(f"Building the single-page HTML (it reads the execution cache; log: {log})", flush=True)
+        rc = build_singlehtml(root, log)
+        if rc != 0:
+            print(log.read_text()[-4000:])
+            print(f"the single-page build failed (exit {rc}); see {log}", file=sys.stderr)
+            return 1
+    print(f"Printing {root / SINGLE_DIR / root_page(root)}.html in headless Chromium", flush=True)
+    held = print_pdf(root / SINGLE_DIR, out, root_page(root))
+    (out.parent / "figures.json").write_text(json.dumps(held, indent=1) + "\n")
+    problems = ([f"images that did not load: {held['broken']}"] if held["broken"] else []) + \
+               ([f"requests off the loopback address: {held['requests']}"] if held["requests"] else [])
+    print(f"{out}: {held['images']} images ({held['interactive']} interactive figures as PNG), "
+          f"{held['math']} formulas, {time.perf_counter() - tic:.0f} s", flush=True)
+    for problem in problems:
+        print("ERROR: " + problem, file=sys.stderr)
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
