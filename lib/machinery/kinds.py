@@ -162,31 +162,111 @@ class Number:
 
 
 def exact(value: float, fmt: str = ".3g") -> Number:
-    """A closed form or a converged computation, rounded to nearest."""
+    """A closed form or a converged computation, rounded to nearest.
+
+    Parameters
+    ----------
+    value : float
+        The unrounded value.
+    fmt : str
+        Its format spec ('.4f', '.2e', '.3g').
+
+    Returns
+    -------
+    Number
+        The number with its kind.
+    """
     return Number(value, Kind.EXACT, fmt)
 
 
 def lower_bound(value: float, fmt: str = ".3g") -> Number:
-    """A certified lower bound, rounded down."""
+    """A certified lower bound, rounded down.
+
+    Parameters
+    ----------
+    value : float
+        The unrounded value.
+    fmt : str
+        Its format spec ('.4f', '.2e', '.3g').
+
+    Returns
+    -------
+    Number
+        The number with its kind.
+    """
     return Number(value, Kind.LOWER, fmt)
 
 
 def upper_bound(value: float, fmt: str = ".3g") -> Number:
-    """A certified upper bound, rounded up."""
+    """A certified upper bound, rounded up.
+
+    Parameters
+    ----------
+    value : float
+        The unrounded value.
+    fmt : str
+        Its format spec ('.4f', '.2e', '.3g').
+
+    Returns
+    -------
+    Number
+        The number with its kind.
+    """
     return Number(value, Kind.UPPER, fmt)
 
 
 def best_found(value: float, fmt: str = ".3g") -> Number:
     """The value of a motion found by a local optimiser: an upper bound on the least possible,
-    rounded up."""
+    rounded up.
+
+    Parameters
+    ----------
+    value : float
+        The unrounded value.
+    fmt : str
+        Its format spec ('.4f', '.2e', '.3g').
+
+    Returns
+    -------
+    Number
+        The number with its kind.
+    """
     return Number(value, Kind.FOUND, fmt)
 
 
 def estimate(value: float, stderr: float, fmt: str = ".2f") -> Number:
-    """A statistic of a run with its (calibrated) standard error, written ``value ± stderr``."""
+    """A statistic of a run with its (calibrated) standard error, written ``value ± stderr``.
+
+    Parameters
+    ----------
+    value : float
+        The estimate.
+    stderr : float
+        Its standard error (>= 0, same unit).
+    fmt : str
+        The format spec of both.
+
+    Returns
+    -------
+    Number
+        The estimate.
+    """
     return Number(value, Kind.ESTIMATE, fmt, stderr=float(stderr))
 
 
 def count(n: int, total: int | None = None) -> Number:
-    """A count, of ``total`` if given."""
+    """A count, of ``total`` if given.
+
+    Parameters
+    ----------
+    n : int
+        The count (>= 0).
+    total : int or None
+        What it counts out of.
+
+    Returns
+    -------
+    Number
+        The count.
+    """
     return Number(n, Kind.COUNT, total=total)
