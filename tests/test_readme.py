@@ -1,5 +1,7 @@
-"""README.md's instructions stay true: its library example runs, and the commands it
-gives for running a chapter as a notebook and the fast tests are the ones installed."""
+"""README.md starts where a newcomer starts, and its instructions stay true: the newcomer's
+sections sit in its first 100 lines, every `make` target it names exists, the caches it names
+are the ones the code writes, every Python example runs, and the build's measurements live in
+benchmarks/README.md, each with its command."""
 
 from __future__ import annotations
 
@@ -8,8 +10,13 @@ import subprocess
 import sys
 from pathlib import Path
 
+import yaml
+
 ROOT = Path(__file__).resolve().parents[1]
 README = (ROOT / "README.md").read_text()
+#: the newcomer's path, in the order a newcomer needs it
+NEWCOMER = ("Two commands", "Where to read", "One chapter at a time", "Use the library", "How to cite")
+FIRST_SCREEN = 100
 
 
 def _section(title: str) -> str:
@@ -18,27 +25,126 @@ def _section(title: str) -> str:
     return match.group(1)
 
 
-def test_readme_library_example_runs():
-    """The python block of "Where to start in the library", run as a script: a small
-    Fig. 5 map with the columns it prints, and the capped circle held at its cap."""
-    (code,) = re.findall(r"```python\n(.*?)```", _section("Where to start in the library"), re.S)
-    proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=300)
-    assert proc.returncode == 0, proc.stderr
-    header, *rows, last = proc.stdout.strip().splitlines()
-    assert header.split() == ["R", "Theta", "regime", "range", "lost", "turns_round"]
-    assert len(rows) == 9 and {r.split()[3] for r in rows} <= {"periodic", "slipping", "chaotic",
-                                                                "quasiperiodic", "undecided"}
-    assert float(last.split()[0]) <= 4.0 + 1e-15          # exact: a clip; measured 0 over the cap; F never above the cap
+def _python_blocks(text: str) -> list[str]:
+    return re.findall(r"^```python\n(.*?)^```", text, re.S | re.M)
 
 
-def test_readme_notebook_route_uses_installed_tools():
-    """The commands of "Working on a chapter" (what tests/test_notebook_route.py runs)
-    name tools the venv has: jupytext, and nbclient's ``jupyter execute``."""
-    text = _section("Working on a chapter")
+def test_newcomers_path_is_in_the_first_100_lines_in_order():
+    """What the book is and found (a paragraph before the first section), then the five
+    sections of the newcomer's path, each ending by line 100; the maintainers' sections after."""
+    lines = README.splitlines()
+    heads = {line[3:]: i for i, line in enumerate(lines) if line.startswith("## ")}
+    starts = [heads.get(t, 10**6) for t in NEWCOMER]
+    assert starts == sorted(starts) and max(starts) < FIRST_SCREEN, (dict(zip(NEWCOMER, starts)))
+    after_last = min([i for i in heads.values() if i > starts[-1]], default=len(lines))
+    assert after_last <= FIRST_SCREEN, f"'How to cite' runs to line {after_last}, past the first {FIRST_SCREEN}"
+    intro = "\n".join(lines[1:min(heads.values())])
+    assert "Korczak" in intro and "found" in intro and "lib/" in intro
+    assert len(intro.split()) <= 150, "the opening paragraph is one paragraph, not a chapter"
+
+
+def test_the_two_commands_are_makes_book_and_test_and_ci_runs_test_then_portable():
+    """The two commands come first; `.ci/run` runs `make test`, then `make test-portable`,
+    as the section says."""
+    text = _section("Two commands")
+    assert "make book" in text and "make test" in text and "make test-portable" in text
+    ci = (ROOT / ".ci" / "run").read_text()
+    calls = re.findall(r"^make (\S+)", ci, re.M)
+    assert calls == ["test", "test-portable"], calls
+
+
+def test_every_make_target_the_readme_names_is_in_the_makefile():
+    make = (ROOT / "Makefile").read_text()
+    targets = set(re.findall(r"^([a-z][\w-]*):", make, re.M))
+    named = set(re.findall(r"\bmake ([a-z][\w-]*)", README))
+    assert {"book", "test", "pdf", "chapter", "test-portable"} <= named
+    assert named <= targets, f"README names make targets the Makefile lacks: {sorted(named - targets)}"
+
+
+def test_where_to_read_names_the_html_and_the_pdf_that_the_tools_write():
+    sys.path.insert(0, str(ROOT / "tools"))
+    from pdf import OUT
+
+    text = _section("Where to read")
+    assert "_build/html/index.html" in text
+    pdf = OUT.relative_to(ROOT).as_posix()
+    assert pdf in text and pdf in _section("How to cite")
+
+
+def test_one_chapter_section_names_the_caches_the_code_writes_and_the_commands_exist():
+    """`make chapter CH=08` resolves to Chapter 8; the section names myst-nb's execution cache
+    (`_config.yml`) and lib.machinery.cache's folder as the code computes them; the notebook
+    route's commands (what tests/test_notebook_route.py runs) name tools the venv has."""
+    from lib.machinery.cache import cache_dir
+
+    sys.path.insert(0, str(ROOT / "tools"))
+    from preexecute import resolve_page
+
+    text = _section("One chapter at a time")
+    assert "make chapter CH=08" in text and resolve_page("08") == "chapters/08_optimal"
+    assert "_build/html/chapters/08_optimal.html" in text
+    execution_cache = yaml.safe_load((ROOT / "_config.yml").read_text())["execute"]["cache"]
+    assert f"`{execution_cache}`" in text
+    assert f"`{cache_dir(ROOT).relative_to(ROOT).as_posix()}`" in text
     assert ".venv/bin/jupytext --to ipynb chapters/01_model.md" in text
     assert ".venv/bin/jupyter execute --inplace chapters/01_model.ipynb" in text
     bin_dir = Path(sys.executable).parent
     assert (bin_dir / "jupytext").is_file() and (bin_dir / "jupyter-execute").is_file()
+
+
+def test_use_the_library_example_runs_and_prints_what_it_says():
+    """The example of "Use the library", run as a script: the capped circle's peak force at the
+    4 N cap, then three points of Fig. 5 with their verdicts."""
+    (code,) = _python_blocks(_section("Use the library"))
+    proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    first, header, *rows = proc.stdout.strip().splitlines()
+    peak, p_range = map(float, first.split())
+    assert peak <= 4.0 and 0.0 <= p_range < 2 * 3.141592653589793   # exact: a clip; F never above its cap
+    assert header.split() == ["R", "Theta", "regime", "range", "lost"]
+    assert len(rows) == 3 and {r.split()[3] for r in rows} <= {"periodic", "slipping", "chaotic", "transient",
+                                                                "quasiperiodic", "undecided"}
+
+
+def test_scaling_out_example_runs_as_a_script(tmp_path):
+    """The dask example of "Scaling out", as a script file (its workers import it), writes its
+    map with one row a point."""
+    (code,) = _python_blocks(_section("Scaling out"))
+    script = tmp_path / "scale.py"
+    script.write_text(code)
+    proc = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    n = int(re.search(r"^N = (\d+)", code, re.M).group(1))
+    rows = (tmp_path / f"fig5_{n}.csv").read_text().strip().splitlines()
+    assert len(rows) == 1 + n * n
+
+
+def test_every_python_block_is_one_the_tests_run():
+    """No example in the README goes unrun: the two above are all there are."""
+    assert len(_python_blocks(README)) == 2
+
+
+def test_how_to_cite_names_the_citation_file_and_it_names_the_paper():
+    text = _section("How to cite")
+    assert "CITATION.cff" in text and "make pdf" in text
+    cff = yaml.safe_load((ROOT / "CITATION.cff").read_text())
+    assert cff["title"] and cff["preferred-citation"]["title"] == cff["title"]
+    paper = cff["references"][0]
+    assert paper["authors"][0]["family-names"] == "Korczak" and paper["year"] == 2014
+
+
+def test_measurements_live_in_benchmarks_readme_each_with_its_command():
+    """The README quotes no build timing; benchmarks/README.md does, and every row of its
+    tables of measurements names the command that measures it (in backticks)."""
+    assert not re.search(r"\d+ min \d+ s|\d+(\.\d+)? s of CPU", README), "a timing in README.md"
+    bench = (ROOT / "benchmarks" / "README.md").read_text()
+    rows = [line for line in bench.splitlines() if line.startswith("|") and not set(line) <= set("|- ")]
+    measured = [r for r in rows if re.search(r"\d+ (min|s)\b", r)]
+    assert len(measured) >= 5
+    for row in measured:
+        cells = [c.strip() for c in row.strip("|").split("|")]
+        assert any(c.startswith("`") and ("make" in c or ".venv/bin" in c or "bash" in c) for c in cells) \
+            or cells[0].startswith(("Chapter", "report")), row
 
 
 def test_readme_fast_tests_command_deselects_the_slow_markers():
@@ -61,9 +167,7 @@ def test_ci_runs_the_portable_tests_after_make_test_with_the_emulation_the_readm
     for var in ("NUMBA_CPU_NAME=generic", "NUMBA_CACHE_DIR", "OPENBLAS_CORETYPE=Prescott", "NPY_DISABLE_CPU_FEATURES"):
         assert var in text, var
     # the numpy feature names the Makefile disables are ones this numpy dispatches on
-    import numpy as np
     from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_baseline__
 
     names = re.search(r'NPY_DISABLE_CPU_FEATURES="([^"]*)"', make).group(1).split()
     assert names and set(names) <= set(__cpu_dispatch__) - set(__cpu_baseline__), (names, __cpu_dispatch__)
-    assert np.__version__
