@@ -38,7 +38,7 @@ from ..percussion.law import ANTI_WINDUP_TIME, closed_loop_rates, error_polynomi
 from ..trajectories import POSITIONS, heading_turns, make
 from .bound import cap_bound
 from .loop import FlowMap, loop_verdict, run_periods, steady_measures
-from .study import PAPER_CAP, SETTINGS, limit_motions, setting_label
+from .study import PAPER_CAP, SETTINGS, cap_alone_chain, limit_motions, setting_label
 from .tracker import periodic_lqr, track_motion
 from .verdict import basin, motion_verdict
 
@@ -363,7 +363,7 @@ def _side_by_side(body, gains, R, Theta, motions, bounds, settings, kind, solved
 
 def limits_study(body: Body, gains: Gains, R: float, Theta: float, *, kind: str = "eight") -> dict:
     """Chapter 8's comparison in one call (cached by the chapter, read by the report): the best
-    motions at every setting (:func:`lib.optimal.study.limit_motions`), the bound under the
+    motions found at every setting (:func:`lib.optimal.study.limit_motions`), the bound under the
     paper's cap (:func:`lib.optimal.bound.cap_bound`, 256 nodes) and the table
     (:func:`side_by_side`).
 
@@ -372,10 +372,13 @@ def limits_study(body: Body, gains: Gains, R: float, Theta: float, *, kind: str 
     dict
         ``motions`` (setting -> PeriodicMotion), ``bound`` (CapBound at the paper's cap),
         ``table`` (pandas.DataFrame), ``basin_setting`` (the first setting whose controller the
-        paper's start does not reach, or the first setting) and ``basin`` (its
-        :func:`lib.optimal.verdict.basin` frame).
+        paper's start does not reach, or the first setting), ``basin`` (its
+        :func:`lib.optimal.verdict.basin` frame), ``cap_chain`` (the cap alone's best found on
+        each mesh, :func:`lib.optimal.study.cap_alone_chain`) and ``bound_at_mesh`` (the bound at
+        the collocation's default mesh, as many nodes as it has intervals).
     """
-    motions = limit_motions(body, R, Theta, kind=kind)
+    chain = cap_alone_chain(body, R, Theta, PAPER_CAP, kind=kind)
+    motions = limit_motions(body, R, Theta, kind=kind, chains={PAPER_CAP: chain})
     bound = cap_bound(body, R, Theta, PAPER_CAP, kind=kind)
     solved = {}
     table = _side_by_side(body, gains, R, Theta, motions, {PAPER_CAP: bound}, SETTINGS, kind, solved)
@@ -384,7 +387,8 @@ def limits_study(body: Body, gains: Gains, R: float, Theta: float, *, kind: str 
     row = (missed if len(missed) else opt).iloc[0]
     key = (None if pd.isna(row.angle_deg) else int(row.angle_deg), None if pd.isna(row.cap) else float(row.cap))
     return dict(motions=motions, bound=bound, table=table, basin_setting=key,
-                basin=_basin(body, motions[key], key, solved))
+                basin=_basin(body, motions[key], key, solved), cap_chain=chain,
+                bound_at_mesh=cap_bound(body, R, Theta, PAPER_CAP, kind=kind, nodes=chain[0].nodes))
 
 
 def _basin(body: Body, motion, key, solved: dict) -> pd.DataFrame:

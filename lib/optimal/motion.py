@@ -120,7 +120,7 @@ class PeriodicMotion:
     @property
     def best_start(self) -> str:
         """The first start (in ``starts``' order) whose RMS lies within :data:`START_TIE` of the least."""
-        return next(n for n, rms, _ in self.starts if rms <= self.rms_error + START_TIE)
+        return min(self.starts, key=lambda s: (not s[1] <= self.rms_error + START_TIE, self.starts.index(s)))[0]
 
     def _locate(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(interval index, local time s in [0, 1), whole periods) of times t (s)."""

@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from ..machinery import checks
+from ..machinery.kinds import round_directed
 from ..params import Body
 from .bound import cap_bound, exact_peak_force
 from .collocation import ACCEPTED
@@ -21,7 +22,7 @@ from .motion import START_TIE, PeriodicMotion, periodic_motion, return_errors
 
 __all__ = ["PAPER_CAP", "CHAPTER_ANGLES_DEG", "SETTINGS", "CAP_REFINED", "MULTISTART_SEED", "setting_label",
            "cap_sweep", "cap_convergence", "limit_motions", "motion_convergence", "multistart", "convergence_table",
-           "motions_table", "mesh_table", "multistart_summary"]
+           "motions_table", "mesh_table", "multistart_summary", "multistart_optima", "cap_alone_chain"]
 
 #: the paper's force cap (N), Fig. 4
 PAPER_CAP = 4.0
@@ -55,6 +56,11 @@ def setting_label(angle_deg, cap) -> str:
     """
     parts = ([] if angle_deg is None else [f"{angle_deg:g} deg"]) + ([] if cap is None else [f"{cap:g} N"])
     return " + ".join(parts) or "none"
+
+
+def _up(value, fmt: str) -> str:
+    """A motion's distance as the page writes a best found value: rounded up (:mod:`lib.machinery.kinds`)."""
+    return round_directed(float(value), fmt, "up")
 
 
 def _check(body, R, Theta, kind):
@@ -122,15 +128,36 @@ def cap_convergence(body: Body, R: float, Theta: float, F_max: float, nodes=(64,
     return pd.DataFrame(rows)
 
 
+def cap_alone_chain(body: Body, R: float, Theta: float, F_max: float, *, kind: str = "eight", nodes: int = 80,
+                    refine=CAP_REFINED) -> tuple:
+    """The best motion found under the cap alone (:func:`lib.optimal.motion.periodic_motion`): at
+    ``nodes`` intervals from every start (the convex one included), then through the meshes
+    ``refine``, each from the one before alone (as :func:`motion_convergence`).
+
+    Returns
+    -------
+    tuple of PeriodicMotion
+        One a mesh, the coarsest first.
+    """
+    R, Theta = _check(body, R, Theta, kind)
+    F_max = checks.number("F_max", F_max, positive=True, unit="N")
+    nodes = checks.integer("nodes", nodes, minimum=8)
+    refine = [checks.integer("refine", n, minimum=nodes + 1) for n in refine]
+    chain = [periodic_motion(body, R, Theta, kind=kind, F_max=F_max, nodes=nodes)]
+    for n in refine:
+        chain.append(periodic_motion(body, R, Theta, kind=kind, F_max=F_max, nodes=n, starts=(),
+                                     guess={f"from {chain[-1].nodes} intervals": chain[-1]}))
+    return tuple(chain)
+
+
 def limit_motions(body: Body, R: float, Theta: float, *, kind: str = "eight", angles_deg=CHAPTER_ANGLES_DEG,
-                  caps=(None, PAPER_CAP), nodes: int = 80, refine=CAP_REFINED) -> dict:
+                  caps=(None, PAPER_CAP), nodes: int = 80, refine=CAP_REFINED, chains=None) -> dict:
     """The best periodic motions found (:func:`lib.optimal.motion.periodic_motion`) at every
     setting: for each cap (N, or None) the angle limits in the given order, each started from its
     own starts and from the best found at the limit before (continuation: the largest limit first,
     so that each smaller one starts from a motion just outside its set); with a cap, the first
-    angle limit also from the cap alone's optimum (itself from every start, the convex one
-    included), which is refined through the meshes ``refine`` (each from the one before, as
-    :func:`motion_convergence`) and kept at the finest under the key (None, cap). Each motion's
+    angle limit also from the cap alone's optimum at ``nodes`` (:func:`cap_alone_chain`, or
+    ``chains[cap]`` if given), whose finest mesh of ``refine`` is kept under the key (None, cap). Each motion's
     ``best_start`` names the start that won (``"from 4 N"``, ``"from 90 deg + 4 N"`` for the
     continuation).
 
@@ -143,17 +170,13 @@ def limit_motions(body: Body, R: float, Theta: float, *, kind: str = "eight", an
     angles = [checks.number("angles_deg", a, positive=True, maximum=180.0) for a in angles_deg]
     caps = [None if c is None else checks.number("caps", c, positive=True, unit="N") for c in caps]
     nodes = checks.integer("nodes", nodes, minimum=8)
-    refine = [checks.integer("refine", n, minimum=nodes + 1) for n in refine]
     out: dict = {}
     for cap in caps:
         guess = None
         if cap is not None:
-            m = periodic_motion(body, R, Theta, kind=kind, F_max=cap, nodes=nodes)
-            guess = {f"from {setting_label(None, cap)}": m}
-            for n in refine:
-                m = periodic_motion(body, R, Theta, kind=kind, F_max=cap, nodes=n, starts=(), guess={
-                    f"from {m.nodes} intervals": m})
-            out[(None, cap)] = m
+            chain = (chains or {}).get(cap) or cap_alone_chain(body, R, Theta, cap, kind=kind, nodes=nodes,
+                                                                refine=refine)
+            guess, out[(None, cap)] = {f"from {setting_label(None, cap)}": chain[0]}, chain[-1]
         for a in angles:
             m = periodic_motion(body, R, Theta, kind=kind, F_max=cap, beta_max=math.radians(a), nodes=nodes,
                                 guess=guess)
@@ -203,6 +226,24 @@ def multistart(body: Body, R: float, Theta: float, beta_max: float, F_max: float
                         shifts=shifts)
     return pd.DataFrame([dict(start=name, rms_error=rms, converged=status in ACCEPTED)
                          for name, rms, status in m.starts])
+
+
+def multistart_optima(frame: pd.DataFrame, tol: float = START_TIE) -> pd.DataFrame:
+    """The distinct optima of :func:`multistart` (RMS errors within ``tol`` (m) of one another are
+    one), best first, as the page shows them: RMS distance (m, six decimals, rounded up), starts
+    ending there, and a last row of the starts that did not converge.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row an optimum.
+    """
+    ok = np.sort(frame.rms_error[frame.converged.astype(bool)].to_numpy())
+    group = np.concatenate([[0], np.cumsum(np.diff(ok) > tol)]) if ok.size else np.zeros(0, int)
+    rows = [{"RMS distance (m)": _up(ok[group == g][0], ".6f"), "starts ending there": int((group == g).sum())}
+            for g in np.unique(group)]
+    return pd.DataFrame(rows + [{"RMS distance (m)": "not converged",
+                                 "starts ending there": int((~frame.converged.astype(bool)).sum())}])
 
 
 def multistart_summary(frame: pd.DataFrame, tol: float = 1e-4) -> dict:
@@ -289,7 +330,8 @@ def convergence_table(conv: pd.DataFrame) -> pd.DataFrame:
 
 def motions_table(motions: dict) -> pd.DataFrame:
     """The best motions found by :func:`limit_motions` under the angle limits: angle limit (deg),
-    cap, RMS and largest distance (m, four decimals), peak force (N, two), the start that won and
+    cap, RMS and largest distance (m, four decimals, rounded up: values of motions found), peak
+    force (N, two), the start that won and
     how many of the starts end within :data:`lib.optimal.motion.START_TIE` of it.
 
     Parameters
@@ -303,7 +345,7 @@ def motions_table(motions: dict) -> pd.DataFrame:
         One row a motion with an angle limit, formatted.
     """
     rows = [{"angle limit (deg)": a, "cap (N)": "none" if c is None else f"{c:g}",
-             "RMS distance (m)": f"{m.rms_error:.4f}", "largest (m)": f"{m.max_error:.4f}",
+             "RMS distance (m)": _up(m.rms_error, ".4f"), "largest (m)": _up(m.max_error, ".4f"),
              "peak F (N)": f"{float(m.F.max()):.2f}", "best start": m.best_start,
              "starts at it": f"{sum(r <= m.rms_error + START_TIE for _, r, _ in m.starts)} of {len(m.starts)}"}
             for (a, c), m in motions.items() if a is not None]
@@ -312,7 +354,7 @@ def motions_table(motions: dict) -> pd.DataFrame:
 
 def mesh_table(conv: dict) -> pd.DataFrame:
     """:func:`motion_convergence`'s frames by cap, as the page shows them: cap, intervals, RMS
-    distance (m), peak force (N), and the return error per quantity: position (m), heading (rad),
+    distance (m, rounded up), peak force (N), and the return error per quantity: position (m), heading (rad),
     velocity (m/s), rate (rad/s).
 
     Parameters
@@ -326,7 +368,7 @@ def mesh_table(conv: dict) -> pd.DataFrame:
         Formatted rows.
     """
     return pd.concat([pd.DataFrame({"cap": "none" if c is None else f"{c:g} N", "intervals": f.nodes,
-                                    "RMS distance (m)": f.rms_error.map("{:.4f}".format),
+                                    "RMS distance (m)": f.rms_error.map(lambda v: _up(v, ".4f")),
                                     "peak F (N)": f.F_peak.map("{:.2f}".format),
                                     **{f"return, {q} ({u})": f[f"return_{q}"].map("{:.0e}".format)
                                        for q, u in (("position", "m"), ("heading", "rad"), ("velocity", "m/s"),
