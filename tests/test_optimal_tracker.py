@@ -435,6 +435,7 @@ rhs = riccati.riccati_rhs(Body(), lqr.motion, tracker.DEFAULT_Q, np.linalg.inv(t
 rhs(0.3, np.eye(6).ravel(), 0.3)
 riccati.closed_loop_rhs(lqr)(0.3, np.eye(6).ravel(), 0.3)
 riccati.loop_rhs(lqr, 2.0, 0.5)(0.3, np.zeros((2, 6)), 0.3)
+riccati.loop_steps(lqr, 2.0, 0.5, [0.0, 0.1], [1], [0.1], [[0.0, 0.1]])(np.zeros((2, 6)), 1e8)
 """
 
 

@@ -2,7 +2,9 @@
 :func:`lib.optimal.motion.periodic_motion` (its collocation polynomials and piecewise-constant
 inputs): the periodic Riccati equation's (:func:`riccati_rhs`) and the linearised closed loop's,
 whose monodromy matrix gives the multipliers (:func:`closed_loop_rhs`); and the clipped closed
-loop of :func:`lib.optimal.tracker.track_motion` itself (:func:`loop_rhs`).
+loop of :func:`lib.optimal.tracker.track_motion` itself (:func:`loop_rhs`), and that loop stepped
+by the classical RK4 over whole input pieces (:func:`loop_steps`, the period map of
+:func:`lib.optimal.verdict.motion_verdict`).
 
 ``solve_ivp`` calls them on one matrix at a time, about 12 000 times a Riccati solution, so the
 numpy versions' cost was their calls' overhead: the motion's state read from its polynomials
@@ -32,7 +34,7 @@ from ..params import Body
 from .collocation import tableau
 from .motion import NODE_SNAP
 
-__all__ = ["riccati_rhs", "closed_loop_rhs", "loop_rhs"]
+__all__ = ["riccati_rhs", "closed_loop_rhs", "loop_rhs", "loop_steps"]
 
 
 
@@ -217,10 +219,48 @@ def _make_loop_rows(stamp: int):
             out[r, 0], out[r, 1], out[r, 2] = X[r, 3], X[r, 4], X[r, 5]
             out[r, 3], out[r, 4], out[r, 5] = _accel(f, b, X[r, 2], X[r, 3], X[r, 4], X[r, 5], m, I, c, cphi, a)
 
-    return _loop_rows
+    @numba.njit(cache=True)
+    def _loop_steps(Y, edges, n, h, lo_in, hi_in, period, nodes, snap, turns, F, beta, basis, colloc, body, R,
+                    grid, PG, dPG, F_max, beta_max, blowup):  # pragma: no cover (compiled)
+        """Classical RK4 on the rows Y (M, 6), in place, over the input pieces [edges[p], edges[p + 1]]
+        with n[p] fixed steps of h[p] (s) each, the inputs of a piece read at a stage time clamped
+        to [lo_in[p], hi_in[p]]: the stage sums of :func:`lib.integrators.batch.steps` in their
+        order. Returns (0, 0, 0), or (1, t, row) where a stage's state exceeds ``blowup`` or its
+        rate is not finite, or (2, t, row) where a step ends non-finite."""
+        M = Y.shape[0]
+        K = np.empty((4, M, 6))
+        yi = np.empty((M, 6))
+        for p in range(edges.size - 1 if stamp >= 0 else 0):
+            for k in range(n[p]):
+                t = edges[p] + k * h[p]
+                for i in range(4):
+                    ts = t + (0.0, 0.5, 0.5, 1.0)[i] * h[p]
+                    w = (0.0, 0.5, 0.5, 1.0)[i] * h[p]
+                    for r in range(M):
+                        for col in range(6):
+                            v = Y[r, col] if i == 0 else Y[r, col] + w * K[i - 1, r, col]
+                            if abs(v) > blowup:
+                                return 1, ts, r
+                            yi[r, col] = v
+                    _loop_rows(ts, min(max(ts, lo_in[p]), hi_in[p]), yi, period, nodes, snap, turns, F, beta,
+                               basis, colloc, body, R, grid, PG, dPG, F_max, beta_max, K[i])
+                    for r in range(M):
+                        for col in range(6):
+                            if not np.isfinite(K[i, r, col]):
+                                return 1, ts, r
+                hb = h[p] / 6.0
+                for r in range(M):
+                    for col in range(6):
+                        acc = ((K[0, r, col] + 2.0 * K[1, r, col]) + 2.0 * K[2, r, col]) + K[3, r, col]
+                        Y[r, col] = Y[r, col] + hb * acc
+                        if not np.isfinite(Y[r, col]):
+                            return 2, edges[p] + (k + 1) * h[p], r
+        return 0, 0.0, 0
+
+    return _loop_rows, _loop_steps
 
 
-_loop_rows = _make_loop_rows(source_stamp(Path(closed_loop.__file__)))
+_loop_rows, _loop_steps = _make_loop_rows(source_stamp(Path(closed_loop.__file__)))
 
 
 def loop_rhs(lqr, F_max: float, beta_max: float | None):
@@ -257,6 +297,48 @@ def loop_rhs(lqr, F_max: float, beta_max: float | None):
         _loop_rows(float(t), float(t_in), X, *arrays, fmax, bmax, out)
         return out
     return rhs
+
+
+def loop_steps(lqr, F_max: float, beta_max: float | None, edges, n, h, inside):
+    """The clipped closed loop of :func:`loop_rhs` stepped by the classical RK4 compiled, or None
+    for a motion without collocation polynomials: equal to :func:`lib.integrators.batch.integrate`
+    with :data:`lib.integrators.batch.RK4` on :func:`loop_rhs`'s rates piece by piece, to rounding
+    (``tests/test_optimal_convergence.py``), without a Python call a stage.
+
+    Parameters
+    ----------
+    lqr : PeriodicLQR
+        The periodic LQR.
+    F_max, beta_max : float, float or None
+        As in :func:`loop_rhs`.
+    edges : array_like
+        The input pieces' ends (s), increasing (P + 1,).
+    n, h : array_like
+        Steps (P,) and their size (s) (P,) on each piece.
+    inside : array_like
+        (P, 2): the clamp of the stage times at which each piece's inputs are read (s).
+
+    Returns
+    -------
+    callable or None
+        ``run(X, blowup)``: the rows X (M, 6) at the last edge, and a status (code, t (s), row):
+        code 1 where a stage's state exceeds ``blowup`` or its rate is not finite, 2 where a step
+        ends non-finite, 0 otherwise.
+    """
+    fmax = checks.number("F_max", F_max, positive=True, finite=False, unit="N")
+    bmax = -1.0 if beta_max is None else checks.number("beta_max", beta_max, positive=True, maximum=math.pi,
+                                                       unit="rad")
+    arrays = _lqr_arrays(lqr)
+    if arrays is None:
+        return None
+    e, hh = np.ascontiguousarray(edges, dtype=float), np.ascontiguousarray(h, dtype=float)
+    nn, ins = np.ascontiguousarray(n, dtype=np.int64), np.ascontiguousarray(inside, dtype=float)
+
+    def run(X, blowup: float):
+        Y = np.array(X, dtype=float, order="C")
+        status = _loop_steps(Y, e, nn, hh, ins[:, 0].copy(), ins[:, 1].copy(), *arrays, fmax, bmax, float(blowup))
+        return (Y, *status)
+    return run
 
 
 def riccati_rhs(body: Body, motion, Q: np.ndarray, R_inv: np.ndarray):

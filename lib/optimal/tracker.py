@@ -29,11 +29,13 @@ from ..model import config_accel, generalized_force
 from ..params import PAPER_DZ0, PAPER_Z0, Body
 from ..simulate import DEFAULT_RATE, SimulationResult
 from ..trajectories import make
+from .motion import PeriodicMotion, verify_motion
 from .riccati import closed_loop_rhs, loop_rhs, riccati_rhs
 
 __all__ = ["PeriodicLQR", "jacobians", "periodic_lqr", "track_motion",
            "DEFAULT_Q", "DEFAULT_R", "RTOL", "NEWTON_TOL", "NEWTON_ITER", "NEWTON_STALL", "REACH_TOL",
-           "REACH_FLOOR", "MAX_RICCATI_PERIODS", "RICCATI_SETTLE", "DEFAULT_STARTS"]
+           "REACH_FLOOR", "MAX_RICCATI_PERIODS", "RICCATI_SETTLE", "DEFAULT_STARTS", "MAX_SAMPLES",
+           "MOTION_RETURN_TOL"]
 
 #: default state weight (SI), Bryson's rule (1 / acceptable error^2) at the errors to recover from (the
 #: paper's start; 1 m, 1.1 rad off the circle's motion); 1 m, 3.2 rad, 1 m/s, 3.2 rad/s cost alike. With
@@ -49,6 +51,11 @@ NEWTON_TOL, NEWTON_ITER, NEWTON_STALL = 1e-7, 12, 4
 REACH_TOL, REACH_FLOOR = 1e-3, 1e-6
 #: periods of the Riccati equation at most; relative change of P(0) a period for P periodic
 MAX_RICCATI_PERIODS, RICCATI_SETTLE = 50, 1e-8
+#: the most output times :func:`track_motion` records by default (about 20 floats a time: 160 MB)
+MAX_SAMPLES = 1e6
+#: the most a motion's inputs may miss returning it to its start on the given body (max-norm, state
+#: units) for :func:`periodic_lqr` to take it as that body's: the reach tolerance
+MOTION_RETURN_TOL = 1e-3
 #: motion_verdict's 7 starts at t = 0; the paper's, then it +-0.5 m in x, +-0.5 m in y, +-pi/2 rad in phi
 DEFAULT_STARTS = np.concatenate([PAPER_Z0, PAPER_DZ0]) + np.array(
     [np.zeros(6)] + [sign * d * np.eye(6)[j] for j, d in ((0, 0.5), (1, 0.5), (2, np.pi / 2)) for sign in (1, -1)])
@@ -79,6 +86,20 @@ def _check_motion(motion: Any) -> None:
     for name, v, shape in (("state(t)[0]", z, (1, 3)), ("state(t)[1]", dz, (1, 3)), ("inputs(t)[0]", F, (1,)),
                            ("inputs(t)[1]", beta, (1,))):
         checks.array("motion." + name, v, shape=shape)
+
+
+def _check_body(body: Body, motion) -> None:
+    """Refuse a motion of :func:`lib.optimal.motion.periodic_motion` that is not a motion of ``body``:
+    its inputs, run on ``body``'s model (:func:`lib.optimal.motion.verify_motion`), miss returning
+    it to its start by more than :data:`MOTION_RETURN_TOL`. (A motion does not record the body it was
+    solved for; a duck-typed motion is taken as given.)"""
+    if not isinstance(motion, PeriodicMotion):
+        return
+    miss = verify_motion(body, motion)
+    if not miss <= MOTION_RETURN_TOL:
+        raise ValueError(f"motion is not a periodic motion of body = {body}: its inputs on that body miss returning "
+                         f"it to its start by {miss:.3g} (max-norm of m, rad, m/s, rad/s; at most "
+                         f"{MOTION_RETURN_TOL:g}); solve it for this body (lib.optimal.periodic_motion(body, ...))")
 
 
 def _weights(Q, R_weight) -> tuple[np.ndarray, np.ndarray]:
@@ -131,8 +152,8 @@ def _edges(motion, t0: float, t1: float) -> np.ndarray:
     return e if t1 >= t0 else e[::-1]
 
 
-def _piecewise_ivp(make_rhs, y0, edges, t_eval, atol: float, what: str):
-    """solve_ivp (DOP853, rtol = RTOL) piece by piece between ``edges`` (so no step straddles an
+def _piecewise_ivp(make_rhs, y0, edges, t_eval, atol: float, what: str, rtol: float = RTOL):
+    """solve_ivp (DOP853, ``rtol``) piece by piece between ``edges`` (so no step straddles an
     input jump): ``make_rhs(lo, hi)`` gives the piece's rate function. Returns y at ``t_eval``
     (ordered as ``edges``) (n, d) and at the end. A failure, a non-finite state or one beyond
     1e8 raises SimulationError naming ``what`` and the time."""
@@ -140,7 +161,7 @@ def _piecewise_ivp(make_rhs, y0, edges, t_eval, atol: float, what: str):
     sign = 1.0 if edges[-1] >= edges[0] else -1.0
     for j, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
         sel = t_eval[(sign * (t_eval - a) >= 0) & (sign * (t_eval - b) < 0)]
-        sol = solve_ivp(make_rhs(min(a, b), max(a, b)), (a, b), y, "DOP853", np.append(sel, b), rtol=RTOL, atol=atol)
+        sol = solve_ivp(make_rhs(min(a, b), max(a, b)), (a, b), y, "DOP853", np.append(sel, b), rtol=rtol, atol=atol)
         if sol.status != 0 or not np.all(np.isfinite(sol.y)) or np.abs(sol.y[:, -1]).max() > 1e8:
             raise SimulationError(f"{what} failed or blew up between t = {a:.6g} s and {b:.6g} s: {sol.message}")
         y = sol.y[:, -1]
@@ -287,6 +308,7 @@ def periodic_lqr(body: Body, motion, *, Q=None, R_weight=None, samples: int = 10
     _check_motion(motion)
     Q, R = _weights(Q, R_weight)
     samples = checks.integer("samples", samples, minimum=16)
+    _check_body(body, motion)
     Rinv, T = np.linalg.inv(R), float(motion.period)
 
     fast = riccati_rhs(body, motion, Q, Rinv)      # compiled, for the motions of periodic_motion
@@ -406,6 +428,22 @@ def _check_loop(body, motion, limits, lqr, Q=None, R_weight=None) -> None:
         raise ValueError("give either lqr or the weights Q, R_weight, not both")
 
 
+def _check_span(motion, t_end: float, default_samples: bool) -> None:
+    """Refuse, before any work, a ``t_end`` (s) over more than :data:`lib.machinery.checks.MAX_RUN_STEPS`
+    input pieces (each a solve of DOP853), or with more default output times than :data:`MAX_SAMPLES`."""
+    breaks = len(getattr(motion, "t", [0.0]))
+    pieces = (math.floor(t_end / float(motion.period)) + 1) * breaks
+    fix = "a shorter t_end, or the steady error over one period (run from the orbit's state)"
+    checks.within_budget({"t_end": pieces}, checks.MAX_RUN_STEPS, what="the run would need",
+                         unit=f"input pieces ({breaks} a period of {float(motion.period):.4g} s), each a solve "
+                         "of DOP853",
+                         fix=fix, values={"t_end": (t_end, "s")})
+    if default_samples:
+        checks.within_budget({"t_end": t_end * DEFAULT_RATE + 1}, MAX_SAMPLES, what="the run would record",
+                             unit=f"output times ({DEFAULT_RATE:g} a second)", fix=fix + ", or fewer times (t_eval)",
+                             values={"t_end": (t_end, "s")})
+
+
 def track_motion(body: Body, motion, t_end: float, *, limits: Limits | None = None, z0=None, dz0=None,
                  Q=None, R_weight=None, t_eval=None, lqr: PeriodicLQR | None = None) -> SimulationResult:
     """The body under the periodic LQR about ``motion``, limits enforced, from t = 0 to ``t_end``.
@@ -433,12 +471,18 @@ def track_motion(body: Body, motion, t_end: float, *, limits: Limits | None = No
     -------
     SimulationResult
         t, z, dz; z_d, dz_d and ``ref`` the *path's* reference (:func:`lib.trajectories.make`), so
-        ``error`` is the error from the path; F (N), beta (rad) the applied (clipped) inputs; tau =
-        (F cos(phi + beta), F sin(phi + beta), F a sin beta) (N, N, N m), the generalised force
-        *applied* (not a computed-torque demand). A blow-up raises SimulationError naming the time.
+        ``error`` = z_d - z is the error from the path, (N, 3) with the heading included: x_d - x (m),
+        y_d - y (m) and phi_d - phi (rad), phi_d the path's heading of eq. (24), not the motion's
+        (C's distance from the path is the norm of the first two columns); F (N), beta (rad) the
+        applied (clipped) inputs; tau = (F cos(phi + beta), F sin(phi + beta), F a sin beta)
+        (N, N, N m), the generalised force *applied* (not a computed-torque demand). A blow-up
+        raises SimulationError naming the time. A ``t_end`` over more than
+        :data:`lib.machinery.checks.MAX_RUN_STEPS` input pieces (each at least one step of DOP853),
+        or whose default output times exceed :data:`MAX_SAMPLES`, is refused before any work.
     """
     _check_loop(body, motion, limits, lqr, Q, R_weight)
     t_end = checks.number("t_end", t_end, positive=True, unit="s")
+    _check_span(motion, t_end, t_eval is None)
     z0 = checks.array("z0", PAPER_Z0 if z0 is None else z0, shape=(3,))
     dz0 = checks.array("dz0", PAPER_DZ0 if dz0 is None else dz0, shape=(3,))
     if t_eval is None:

@@ -1,6 +1,27 @@
 """The controller of :mod:`lib.optimal.tracker` decided by the book's procedure: Newton on the
 clipped closed loop's period map, its Floquet multipliers, and the reach test from a set of starts
-(:mod:`lib.dynamics.verdicts`)."""
+(:mod:`lib.dynamics.verdicts`), each on a map shown converged in its step.
+
+The clipped loop is a continuous field whose derivative jumps where a demanded input meets its
+limit. Along a best motion the force sits at its cap for most of the period, so the orbit runs
+beside those kinks. Three consequences shape this module:
+
+- RK4 with a kink inside a step keeps only second order (the orbit moves 4 times less when the
+  step is halved, ``tests/test_optimal_convergence.py``), and no grid of steps can follow kinks
+  that move with the state. Each verdict is therefore taken on two maps, h and h / 2, and decided
+  only when the orbit moves by at most :data:`ORBIT_SHIFT_TOL` between them; the steps are doubled
+  from the ones asked for until it does (at most :data:`lib.machinery.checks.MAX_STEPS` a period).
+- The field is continuous, so where the orbit crosses a kink transversally the saltation matrix is
+  the identity and the period map is differentiable; but a kink within a difference step of the
+  orbit bends the difference quotient, and one through the orbit point makes the map not
+  differentiable there. The Jacobian is taken by central differences of step d, and the verdict
+  stands only when the largest multiplier's modulus from the central differences of step d and
+  the forward and backward ones of step d and d / 2 agree within :data:`MULTIPLIER_TOL`
+  (a kink through the point parts forward from backward; one between d / 2 and d, the steps).
+- A start far from the orbit wanders for periods before it meets the basin, and where it meets it
+  depends on the step. A start reaches the orbit when it does on both maps; a start whose fate
+  differs between them is not settled (``settled`` False).
+"""
 
 from __future__ import annotations
 
@@ -13,26 +34,47 @@ import pandas as pd
 from ..allocation import Limits
 from ..dynamics.orbits import floquet_multipliers, newton
 from ..dynamics.verdicts import reached
-from ..integrators.batch import RK4, integrate
-from ..integrators.smooth import SimulationError
+from ..integrators.batch import RK4, fixed_steps, integrate
+from ..integrators.smooth import Integration, SimulationError
 from ..machinery import checks
 from ..params import Body
+from .riccati import loop_steps
 from .tracker import (DEFAULT_STARTS, NEWTON_ITER, NEWTON_STALL, NEWTON_TOL, REACH_FLOOR, REACH_TOL, RTOL,
-                      PeriodicLQR, _check_loop, _edges, _limits, _loop, _piecewise_ivp, _reference, periodic_lqr)
+                      PeriodicLQR, _check_loop, _edges, _inside_bounds, _limits, _loop, _piecewise_ivp, _reference,
+                      periodic_lqr)
 
-__all__ = ["MotionVerdict", "motion_verdict", "basin"]
+__all__ = ["MotionVerdict", "motion_verdict", "basin", "ORBIT_SHIFT_TOL", "MULTIPLIER_TOL", "FINE_RTOL"]
+
+#: the most the orbit may move (max-norm, state units) when the step is halved: a tenth of the
+#: reach tolerance :data:`lib.optimal.tracker.REACH_TOL`, so that a start's distance to it is
+#: decided by the dynamics, not by the step
+ORBIT_SHIFT_TOL = 0.1 * REACH_TOL
+#: the most |mu_1| may change between central differences of step d and d / 2: the verdict reads
+#: |mu_1| < 1, and the reach test |mu_1| ** (periods / 2) against a factor 3
+MULTIPLIER_TOL = 0.05
+#: the adaptive map's second tolerance (``steps`` = 0): DOP853 at rtol = atol = RTOL / 100
+FINE_RTOL = RTOL / 100
+#: a state beyond this magnitude (m, rad, m/s, rad/s) has blown up
+BLOWUP = Integration.blowup
 
 
 @dataclass(frozen=True)
 class MotionVerdict:
     """What :func:`motion_verdict` decides: ``regime`` ("periodic" or "undecided", words of
     :data:`lib.dynamics.verdicts.REGIMES`) and ``reason`` ("" when periodic); ``x`` (6,) the
-    orbit's point at t = 0 mod T (m, m, rad, m/s, m/s, rad/s; NaN without one), ``residual``
-    Newton's (max-norm), ``multipliers`` (6,) the Floquet multipliers there (complex, decreasing
-    modulus); ``offset`` (6,) = x minus the motion's own state at 0 (how far the clipped loop's
-    orbit is from the designed motion), ``position_offset`` (m) and ``heading_offset`` (rad) its
-    parts; per start (S,) ``reached`` and ``distance``, the final section distance to the orbit
-    point (max-norm, heading unwrapped; NaN without an orbit), after ``periods`` periods."""
+    orbit's point at t = 0 mod T on the finer map (m, m, rad, m/s, m/s, rad/s; NaN without one),
+    ``residual`` Newton's there (max-norm), ``multipliers`` (6,) its Floquet multipliers from
+    differences of step h (complex, decreasing modulus); ``offset`` (6,) = x minus the motion's
+    own state at 0 (how far the clipped loop's orbit is from the designed motion),
+    ``position_offset`` (m) and ``heading_offset`` (rad) its parts. The integration: ``steps``
+    RK4 steps on each input piece for the coarser map, twice as many for the finer (0: DOP853 at
+    :data:`lib.optimal.tracker.RTOL` and :data:`FINE_RTOL`); ``orbit_shift`` how far the orbit
+    moved between the two (max-norm, state units), ``multiplier_spread`` the range of |mu_1| over
+    the central and one-sided difference Jacobians of step h and h / 2. Per start (S,):
+    ``reached`` (on both maps), ``settled``
+    (the same fate on both) and ``distance``, the finer map's final section distance to the orbit
+    point (max-norm, heading unwrapped; NaN when the starts were not run), after ``periods``
+    periods; starts are run only when the orbit is periodic."""
 
     regime: str
     reason: str
@@ -45,16 +87,32 @@ class MotionVerdict:
     reached: np.ndarray
     distance: np.ndarray
     periods: int
+    steps: int = 0
+    orbit_shift: float = math.nan
+    multiplier_spread: float = math.nan
+    settled: np.ndarray | None = None
 
 
-def _period_map(lqr: PeriodicLQR, F_max, beta_max, steps: int = 0):
+def _period_map(lqr: PeriodicLQR, F_max, beta_max, steps: int = 0, rtol: float = RTOL):
     """x (M, 6) at t = 0 -> the state after one period less the heading's 2 pi turns (M, 6): back
     in the frame of t = 0, so the motion is a fixed point. ``steps`` > 0: classical RK4 with that
-    many fixed steps on each input piece, all rows at once (no step straddles an input jump)."""
+    many fixed steps on each input piece, all rows at once (no step straddles an input jump),
+    compiled (:func:`lib.optimal.riccati.loop_steps`) for a motion with collocation polynomials;
+    0: DOP853 at ``rtol`` piece by piece, row by row when a limit may clip."""
     shift, edges = 2 * np.pi * lqr.motion.turns * np.eye(6)[2], _edges(lqr.motion, 0.0, lqr.motion.period)
-    memo = {}     # every call meets the same stage times: the motion and its gain there, once
+    memo, compiled = {}, None     # memo: the motion and its gain at each stage time, which every call meets
+    if steps:
+        n, h = np.array([fixed_steps(a, b, (b - a) / steps) for a, b in zip(edges[:-1], edges[1:])]).T
+        inside = np.array([_inside_bounds(a, b) for a, b in zip(edges[:-1], edges[1:])])
+        compiled = loop_steps(lqr, F_max, beta_max, edges, n.astype(int), h, inside)
 
     def fixed(X):
+        if compiled is not None:
+            Y, code, t, row = compiled(X, BLOWUP)
+            if code:
+                raise SimulationError(f"the period map blew up at t = {t:.6g} s (start {row}: a state beyond "
+                                      f"{BLOWUP:g} or a rate not finite)")
+            return Y
         y = X.ravel()
         try:
             for a, b in zip(edges[:-1], edges[1:]):
@@ -68,25 +126,76 @@ def _period_map(lqr: PeriodicLQR, F_max, beta_max, steps: int = 0):
         if steps:
             return fixed(X) - shift
         B = [X] if F_max == math.inf and beta_max is None else [x[None] for x in X]
-        return np.concatenate([_piecewise_ivp(_loop(lqr, F_max, beta_max, len(b)), b.ravel(), edges, [], RTOL,
-                                              "the period map")[1].reshape(-1, 6) for b in B]) - shift
+        return np.concatenate([_piecewise_ivp(_loop(lqr, F_max, beta_max, len(b)), b.ravel(), edges, [], rtol,
+                                              "the period map", rtol=rtol)[1].reshape(-1, 6) for b in B]) - shift
     return advance
 
 
+def _difference_step(advance, d: float):
+    """Newton's ``step``: P(x) and its Jacobian by central differences of step d, all rows at once."""
+    def step(idx, x, k):
+        N, E = x.shape[0], d * np.eye(6)
+        Y = advance(np.concatenate([x] + [x + e for e in E] + [x - e for e in E]))
+        plus, minus = Y[N:7 * N].reshape(6, N, 6), Y[7 * N:].reshape(6, N, 6)
+        return Y[:N], np.moveaxis((plus - minus) / (2 * d), 0, -1)
+    return step
+
+
+def _one_sided(advance, x, d: float) -> list:
+    """The four one-sided difference Jacobians of the map at x (6,): forward and backward, of step
+    d and d / 2. Where the map is differentiable near x they agree with the central ones to
+    O(d |P''|); a kink of the map through x parts the forward from the backward, one between
+    d / 2 and d the steps."""
+    E = np.eye(6)
+    Y = advance(np.concatenate([x[None]] + [x + s * e * E for e in (d, d / 2) for s in (1.0, -1.0)]))
+    return [s * (Y[1 + 6 * i:7 + 6 * i] - Y[0]).T / e for i, (e, s) in enumerate((e, s) for e in (d, d / 2)
+                                                                                for s in (1.0, -1.0))]
+
+
+def _orbit(advance, x0, d: float):
+    """Newton's result on the map ``advance`` from x0 (6,) with differences of step d."""
+    return newton(_difference_step(advance, d), np.zeros(1, int), x0[None], 1, turn_axis=2, turns=np.zeros(1, int),
+                  tol=NEWTON_TOL, max_iter=NEWTON_ITER, stall_after=NEWTON_STALL)
+
+
+def _radius(mult) -> float:
+    """|mu_1|, the modulus of the largest multiplier (``mult`` sorted by decreasing modulus)."""
+    return float(np.abs(mult[0]))
+
+
+def _ladder(steps: int, pieces: int) -> list:
+    """The maps tried, coarse to fine: (steps, rtol) doubling from ``steps`` while a period's
+    steps stay within :data:`lib.machinery.checks.MAX_STEPS` (at least one halving), or the two
+    tolerances of DOP853 for ``steps`` = 0."""
+    if steps == 0:
+        return [(0, RTOL), (0, FINE_RTOL)]
+    out = [(steps, RTOL), (2 * steps, RTOL)]
+    while 2 * out[-1][0] * pieces <= checks.MAX_STEPS:
+        out.append((2 * out[-1][0], RTOL))
+    return out
+
+
 def motion_verdict(body: Body, motion, *, limits: Limits | None = None, starts=None, periods: int = 20,
-                   lqr: PeriodicLQR | None = None, h: float = 1e-5, steps: int = 0) -> MotionVerdict:
+                   lqr: PeriodicLQR | None = None, h: float = 1e-5, steps: int = 8) -> MotionVerdict:
     """Decide the clipped closed loop of :func:`lib.optimal.tracker.track_motion` with the book's procedure.
 
-    Newton (:func:`lib.dynamics.orbits.newton`, tol :data:`lib.optimal.tracker.NEWTON_TOL`, :data:`lib.optimal.tracker.NEWTON_ITER` steps,
-    after :data:`lib.optimal.tracker.NEWTON_STALL` only while the residual halves) on the period map P (one period of
-    the loop from a state at t = 0 mod T), P(x) = x + (0, 0, 2 pi turns, 0, 0, 0), from the
-    motion's state at 0; the Jacobian by central differences of step ``h`` (the state's units).
-    "periodic" when Newton converges and every Floquet
-    multiplier lies inside the unit circle, else "undecided" with the reason. Then each of
-    ``starts`` ((S, 6) states at t = 0, default :data:`lib.optimal.tracker.DEFAULT_STARTS`) runs ``periods`` (>= 2)
-    periods and has reached the orbit (:func:`lib.dynamics.verdicts.reached`, tol
-    :data:`lib.optimal.tracker.REACH_TOL`, floor :data:`lib.optimal.tracker.REACH_FLOOR`) when its last section distance is below the
-    tolerance and has shrunk since ``periods // 2`` periods before as |mu_1| allows.
+    Newton (:func:`lib.dynamics.orbits.newton`, tol :data:`lib.optimal.tracker.NEWTON_TOL`,
+    :data:`lib.optimal.tracker.NEWTON_ITER` steps, after :data:`lib.optimal.tracker.NEWTON_STALL`
+    only while the residual halves) on the period map P (one period of the loop from a state at
+    t = 0 mod T), P(x) = x + (0, 0, 2 pi turns, 0, 0, 0), from the motion's state at 0; the
+    Jacobian by central differences of step ``h`` (the state's units). Newton runs on a map and
+    on the map of half its step (from the first map's orbit); while the orbit moves by more than
+    :data:`ORBIT_SHIFT_TOL` between them the steps are doubled. "periodic" when Newton converges
+    on both, the orbit moved by at most :data:`ORBIT_SHIFT_TOL`, |mu_1| from the central
+    differences and from the forward and backward ones of step h and h / 2 on the finer map
+    agree within :data:`MULTIPLIER_TOL` and every Floquet multiplier lies inside the unit circle;
+    else "undecided" with the reason. Then each of ``starts``
+    ((S, 6) states at t = 0, default :data:`lib.optimal.tracker.DEFAULT_STARTS`) runs
+    ``periods`` (>= 2) periods on both maps and has reached the orbit
+    (:func:`lib.dynamics.verdicts.reached`, tol :data:`lib.optimal.tracker.REACH_TOL`, floor
+    :data:`lib.optimal.tracker.REACH_FLOOR`) when on both its last section distance to the
+    map's orbit is below the tolerance and has shrunk since ``periods // 2`` periods before as
+    |mu_1| allows.
 
     Parameters
     ----------
@@ -95,9 +204,10 @@ def motion_verdict(body: Body, motion, *, limits: Limits | None = None, starts=N
     starts, periods, h
         See above.
     steps : int
-        0: the period map by adaptive DOP853 (:data:`lib.optimal.tracker.RTOL`) piece by piece; > 0: classical RK4 with
-        ``steps`` fixed steps on each input piece (the map of the discretised loop, far cheaper
-        where the clipping kinks the field at the orbit).
+        > 0: classical RK4 with ``steps`` fixed steps on each input piece for the first (coarsest)
+        map, doubled as above; 0: DOP853 piece by piece at rtol = atol =
+        :data:`lib.optimal.tracker.RTOL` and at :data:`FINE_RTOL` (row by row where a limit may
+        clip: far dearer).
 
     Returns
     -------
@@ -108,74 +218,126 @@ def motion_verdict(body: Body, motion, *, limits: Limits | None = None, starts=N
     periods = checks.integer("periods", periods, minimum=2)
     h = checks.number("h", h, positive=True, maximum=0.1)
     steps = checks.integer("steps", steps, minimum=0)
+    pieces = len(_edges(motion, 0.0, motion.period)) - 1
+    checks.within_budget({"steps": 2 * steps * pieces}, checks.MAX_STEPS, what="its finer map would need",
+                         unit="fixed steps a period", values={"steps": (steps, "a piece")},
+                         fix=f"the motion has {pieces} input pieces a period")
     lqr = lqr or periodic_lqr(body, motion)
-    advance = _period_map(lqr, *_limits(limits, motion), steps)
-
-    def step(idx, x, k):
-        N, E = x.shape[0], h * np.eye(6)
-        Y = advance(np.concatenate([x] + [x + e for e in E] + [x - e for e in E]))
-        plus, minus = Y[N:7 * N].reshape(6, N, 6), Y[7 * N:].reshape(6, N, 6)
-        return Y[:N], np.moveaxis((plus - minus) / (2 * h), 0, -1)
-
+    F_max, beta_max = _limits(limits, motion)
     x_star = _reference(motion, 0.0)[0]
-    res = newton(step, np.zeros(1, int), x_star[None], 1, turn_axis=2, turns=np.zeros(1, int), tol=NEWTON_TOL,
-                 max_iter=NEWTON_ITER, stall_after=NEWTON_STALL)
-    return _decide(res, advance, x_star, starts, periods)
+    ladder = _ladder(steps, pieces)
+    coarse = _period_map(lqr, F_max, beta_max, *ladder[0])
+    orb_c = _orbit(coarse, x_star, h)
+    for j in range(1, len(ladder)):
+        fine = _period_map(lqr, F_max, beta_max, *ladder[j])
+        start = orb_c.x[0] if orb_c.residual[0] <= NEWTON_TOL else x_star
+        orb_f = _orbit(fine, start, h)
+        shift = float(np.abs(orb_f.x[0] - orb_c.x[0]).max())
+        if not (shift > ORBIT_SHIFT_TOL) or j == len(ladder) - 1:
+            break
+        coarse, orb_c = fine, orb_f
+    return _decide(orb_c, orb_f, coarse, fine, x_star, starts, periods, h, ladder[j - 1][0], shift)
 
 
-def _decide(orb, advance, x_star, starts, periods) -> MotionVerdict:
-    """The verdict from Newton's result, and the runs from the starts when there is an orbit."""
-    ok, J = bool(orb.residual[0] <= NEWTON_TOL), orb.jacobian[0]
+def _decide(orb_c, orb_f, coarse, fine, x_star, starts, periods, h, steps, shift) -> MotionVerdict:
+    """The verdict from Newton's results on the two maps, and the runs from the starts when periodic."""
+    ok = bool(orb_c.residual[0] <= NEWTON_TOL and orb_f.residual[0] <= NEWTON_TOL)
+    x, J = orb_f.x[0], orb_f.jacobian[0]
     mult = floquet_multipliers(J) if np.all(np.isfinite(J)) else np.full(6, np.nan + 0j)
-    rho = float(np.abs(mult[0]))
-    reason = ("" if ok and rho < 1.0 else f"the orbit does not attract (|mu_1| = {rho:.6g})" if ok
-              else f"Newton did not converge (residual {orb.residual[0]:.3g})")
-    x, dist, hit = (orb.x[0] if ok else np.full(6, np.nan)), np.full((periods + 1, len(starts)), np.nan), False
+    rho, spread = _radius(mult), math.nan
     if ok:
-        X = np.array(starts, dtype=float)
-        for j in range(periods + 1):
-            dist[j], X = np.abs(X - x).max(axis=1), (advance(X) if j < periods else X)
-        hit = reached(dist[-1], dist[-1 - periods // 2], rho, periods // 2, tol=REACH_TOL, floor=REACH_FLOOR) & (rho < 1)
-    off = x - x_star
-    return MotionVerdict(regime="undecided" if reason else "periodic", reason=reason, x=x,
-                         residual=float(orb.residual[0]), multipliers=mult, offset=off,
+        radii = [_radius(floquet_multipliers(Jd)) if np.all(np.isfinite(Jd)) else math.inf
+                 for Jd in _one_sided(fine, x, h)]
+        spread = max(radii) - min(radii + [rho])
+    what = f"{2 * steps} RK4 steps a piece" if steps else f"rtol {FINE_RTOL:g}"
+    reason = ("" if ok and shift <= ORBIT_SHIFT_TOL and spread <= MULTIPLIER_TOL and rho < 1.0
+              else f"Newton did not converge (residual {max(orb_c.residual[0], orb_f.residual[0]):.3g})" if not ok
+              else f"the orbit moved by {shift:.3g} (more than {ORBIT_SHIFT_TOL:g}) at {what}"
+              if not shift <= ORBIT_SHIFT_TOL
+              else f"|mu_1| from central and one-sided differences of step {h:g} and {h / 2:g} differ by "
+                   f"{spread:.3g} (more than {MULTIPLIER_TOL:g}): the map is not differentiable there"
+              if not spread <= MULTIPLIER_TOL
+              else f"the orbit does not attract (|mu_1| = {rho:.6g})")
+    S = len(starts)
+    hit, settled, dist = np.zeros(S, bool), np.zeros(S, bool), np.full(S, np.nan)
+    if not reason:
+        fates = [_reach(adv, orb.x[0], starts, periods, rho) for adv, orb in ((coarse, orb_c), (fine, orb_f))]
+        hit, settled, dist = fates[0][0] & fates[1][0], fates[0][0] == fates[1][0], fates[1][1]
+    xo = x if ok else np.full(6, np.nan)
+    off = xo - x_star
+    return MotionVerdict(regime="undecided" if reason else "periodic", reason=reason, x=xo,
+                         residual=float(orb_f.residual[0]), multipliers=mult, offset=off,
                          position_offset=float(np.hypot(off[0], off[1])), heading_offset=float(off[2]),
-                         reached=np.broadcast_to(hit, dist[-1].shape).copy(), distance=dist[-1], periods=periods)
+                         reached=hit, distance=dist, periods=periods, steps=steps, orbit_shift=shift,
+                         multiplier_spread=spread, settled=settled)
+
+
+def _reach(advance, x, starts, periods: int, rho: float):
+    """Run the starts ``periods`` periods on one map: (reached (S,), final distance to x (S,)); a
+    run that blows up has not reached."""
+    dist, X = np.full((periods + 1, len(starts)), np.nan), np.array(starts, dtype=float)
+    with np.errstate(all="ignore"):
+        for j in range(periods + 1):
+            dist[j] = np.abs(X - x).max(axis=1)
+            if j < periods:
+                X = _advance_rows(advance, X)
+    dist = np.where(np.isfinite(dist), dist, np.inf)
+    return reached(dist[-1], dist[-1 - periods // 2], rho, periods // 2, tol=REACH_TOL, floor=REACH_FLOOR), dist[-1]
+
+
+def _advance_rows(advance, X):
+    """One period of the rows X; where the batch blows up, the rows alone (those that blow up become NaN)."""
+    try:
+        return advance(X)
+    except SimulationError:
+        out = np.full_like(X, np.nan)
+        for i, s in enumerate(X):
+            if np.isfinite(s).all():
+                try:
+                    out[i] = advance(s[None])[0]
+                except SimulationError:
+                    pass
+        return out
 
 
 def basin(body: Body, motion, verdict: MotionVerdict, *, limits: Limits | None = None, lqr: PeriodicLQR | None = None,
           heading_offsets=np.linspace(-np.pi, np.pi, 13), position_offsets=np.linspace(-1.0, 1.0, 9),
-          periods: int = 8, steps: int = 2):
+          periods: int = 8, steps: int | None = None):
     """Which starts the controller brings to the orbit of ``verdict``: the paper's start at rest
     moved by each heading offset (rad) and each offset of x (m), run ``periods`` periods on the
-    period map of :func:`motion_verdict` (``steps`` as there); reached when the final section
-    distance to the orbit point (max-norm) is below :data:`lib.optimal.tracker.REACH_TOL`.
+    period maps of :func:`motion_verdict` with RK4 of ``steps`` and twice as many steps on each
+    input piece (``steps`` at least ``verdict.steps``, whose orbit moved by at most
+    :data:`ORBIT_SHIFT_TOL` when they were doubled; default ``verdict.steps``, or 8 after an
+    adaptive verdict); reached when on both maps the final section distance to the orbit point
+    (max-norm) is below :data:`lib.optimal.tracker.REACH_TOL`, settled when both maps agree.
 
     Returns
     -------
     pandas.DataFrame
-        Columns heading_offset (rad), x_offset (m), distance (state units), reached.
+        Columns heading_offset (rad), x_offset (m), distance (state units, the finer map's),
+        reached, settled.
     """
     _check_loop(body, motion, limits, lqr)
     checks.instance("verdict", verdict, MotionVerdict)
     hs = checks.array("heading_offsets", heading_offsets, ndim=1, nonempty=True)
     xs = checks.array("position_offsets", position_offsets, ndim=1, nonempty=True)
     periods = checks.integer("periods", periods, minimum=1)
-    steps = checks.integer("steps", steps, minimum=1)
+    steps = max(verdict.steps or 8, 0 if steps is None else checks.integer("steps", steps, minimum=1))
     if not np.isfinite(verdict.x).all():
         raise ValueError("verdict has no orbit (regime 'undecided'): no basin to draw")
     lqr = lqr or periodic_lqr(body, motion)
-    advance = _period_map(lqr, *_limits(limits, motion), steps)
     H, X = np.meshgrid(hs, xs)
-    S = np.tile(DEFAULT_STARTS[0], (H.size, 1))
-    S[:, 2] += H.ravel()
-    S[:, 0] += X.ravel()
-    with np.errstate(all="ignore"):
-        for _ in range(periods):
-            try:
-                S = advance(S)
-            except SimulationError:      # rows that blow up are not reached; run the rest alone
-                S = np.array([advance(s[None])[0] if np.isfinite(s).all() else s for s in S])
-    d = np.abs(S - verdict.x).max(axis=1)
-    d = np.where(np.isfinite(d), d, np.inf)
-    return pd.DataFrame(dict(heading_offset=H.ravel(), x_offset=X.ravel(), distance=d, reached=d < REACH_TOL))
+    S0 = np.tile(DEFAULT_STARTS[0], (H.size, 1))
+    S0[:, 2] += H.ravel()
+    S0[:, 0] += X.ravel()
+    d = []
+    for s in (steps, 2 * steps):
+        advance, S = _period_map(lqr, *_limits(limits, motion), s), S0
+        with np.errstate(all="ignore"):
+            for _ in range(periods):
+                S = _advance_rows(advance, S)
+        e = np.abs(S - verdict.x).max(axis=1)
+        d.append(np.where(np.isfinite(e), e, np.inf))
+    hit = (d[0] < REACH_TOL, d[1] < REACH_TOL)
+    return pd.DataFrame(dict(heading_offset=H.ravel(), x_offset=X.ravel(), distance=d[1], reached=hit[0] & hit[1],
+                             settled=hit[0] == hit[1]))
