@@ -13,6 +13,7 @@ import numpy as np
 
 from ..angles import wrap_angle
 from ..integrators import batch
+from ..integrators.compiled import rotation_flow
 from ..machinery import checks
 from ..params import Body
 from .reduced import ENGINES, _forcing, _shape, _unit_forcing, steps_per_period
@@ -72,8 +73,6 @@ class _Engine:
 
     def flow(self, phi, w, A, B, C, periods, *, jac=False, renorm=False):
         if self.engine == "numba":
-            from ..integrators.compiled import rotation_flow  # numba's import and compile cost seconds
-
             return rotation_flow(phi, w, A, B, C, periods, self.X1, self.Y1, self.X2, self.Y2, self.hA, self.hB,
                                  jac=jac, renorm=renorm, wind2pi=self.w2pi)
         return _flow_numpy(self, phi, w, A, B, C, periods, jac=jac, renorm=renorm)
@@ -82,8 +81,6 @@ class _Engine:
         """The Lyapunov flow: ``c`` periods of the states ``s`` carrying the tangent vector (first
         column of J), renormalised every period, with the range of p on the way."""
         if self.engine == "numba":
-            from ..integrators.compiled import rotation_flow  # numba's import and compile cost seconds
-
             return rotation_flow(s["phi"], s["w"], s["A"], s["B"], s["C"], c, self.X1, self.Y1, self.X2, self.Y2,
                                  self.hA, self.hB, J=J, renorm=True, H=self.H, wind2pi=self.w2pi)
         return _flow_numpy(self, s["phi"], s["w"], s["A"], s["B"], s["C"], c, renorm=True, H=self.H, J0=J)

@@ -195,7 +195,10 @@ def _period(phi, w, A, B, C, h, X1, Y1, X2, Y2, kind):
 
 def _period_compiled(phi, w, A, B, C, h, X1, Y1, X2, Y2, kind):
     """:func:`_period` by the compiled engine (numba; the default, see the benchmark)."""
-    from ..integrators.compiled import rotation_period  # numba's import and compile cost seconds
+    # imported here, not at the top: lib.integrators.compiled imports lib.rotation.field, whose package's
+    # __init__ imports this module, so a top-level import would meet compiled half initialised whenever it
+    # is imported first (tests/test_layout.py: the cycle through a package)
+    from ..integrators.compiled import rotation_period
 
     tab = batch.dop853()
     return rotation_period(phi, w, A, B, C, h, X1, Y1, X2, Y2, tab.A * h, tab.b * h)

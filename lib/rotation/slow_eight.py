@@ -247,8 +247,8 @@ def _period(phi, A, B, C, f, n: int, corrected: bool, record: bool = False):
     ``record`` on the compiled engine (:func:`lib.integrators.compiled.overdamped_period`, the
     same steps point by point), with it vectorised here."""
     if not record:
-        # imported here: numba's import and compile, and the compiled engine imports
-        # lib.rotation.field, whose package imports this module
+        # imported here, not at the top: lib.integrators.compiled imports lib.rotation.field, whose
+        # package's __init__ imports this module (the cycle through a package, tests/test_layout.py)
         from ..integrators.compiled import overdamped_period
         return overdamped_period(phi, A, B, C, f, n, corrected)
     h = 2 * np.pi / n
