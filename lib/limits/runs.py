@@ -14,6 +14,7 @@ import numpy as np
 from ..machinery import checks
 from ..angles import wrap_angle
 from ..integrators.batch import dop853
+from ..integrators.switched_compiled import dop853_dense, run_periods
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from ..trajectories import KINEMATICS, Circle, Eight, Reference
 
@@ -97,8 +98,9 @@ def _limits_arrays(angle_limits, force_limits):
         i = int(np.flatnonzero(~((b > 0) & (b <= np.pi)))[0])
         raise ValueError(f"angle_limits[{i}] must be in (0, pi] rad, got {float(b[i])!r}")
     if np.any(np.isnan(f)) or not np.all(f > 0):
-        bad = f[np.isnan(f) | ~(f > 0)]
-        raise ValueError(f"every force limit must be positive (N) or inf for none, got {bad[:3]}")
+        i = int(np.flatnonzero(np.isnan(f) | ~(f > 0))[0])
+        where = f"[{i}]" if np.ndim(force_limits) else ""
+        raise ValueError(f"force_limits{where} must be positive (N), or inf or None for none, got {float(f[i])!r}")
     return b.copy(), f.copy()
 
 
@@ -108,7 +110,7 @@ def _check_parts(body, gains, ref) -> None:
     checks.instance("gains", gains, Gains)
     checks.instance("ref", ref, (Circle, Eight), "lib.trajectories.Circle or Eight")
     checks.loop_domain(body, gains, KINEMATICS["circle" if isinstance(ref, Circle) else "eight"], [ref.R],
-                       [ref.theta], heading_gains=False)      # the domain before any run (issue 37)
+                       [ref.theta], heading_gains=False, names=("ref.R", "ref.theta"))   # before any run (issue 37)
 
 
 def _start_states(s0, n: int) -> np.ndarray:
@@ -223,8 +225,6 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
     g = gains
     P = np.array([body.m, body.I, body.a, body.c, body.c_phi, g.kp[0], g.kp[1], g.kv[0], g.kv[1], ref.R, ref.theta,
                   k_slide, 0.0 if isinstance(ref, Circle) else 1.0])
-    from ..integrators.switched_compiled import dop853_dense, run_periods  # numba: imported once checked
-
     tab = dop853()
     T = ref.period
     # with S samples per period the kernel's "period" is T / S: the reference is T-periodic,

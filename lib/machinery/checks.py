@@ -25,9 +25,10 @@ from typing import Any, Iterable, Mapping
 
 import numpy as np
 
-from .domain import (MAX_DAMPING_PERIODS, MAX_ODE_STEPS, MAX_RUN_STEPS, MAX_STEPS, RK4_REACH,  # re-exported
-                     STEPS_PER_RADIAN, by_scale, heading_damping, loop_domain, loop_modes, path_budget, path_extremes, run_steps, scale_culprit, steps_domain,
-                     within_budget)
+from .domain import (H_DAMP, MAX_DAMPING_PERIODS, MAX_GRID_POINTS, MAX_ODE_STEPS, MAX_RUN_STEPS,  # re-exported
+                     MAX_SAMPLES, MAX_STEPS, RK4_REACH, STEPS_PER_RADIAN, by_scale, grid_budget, heading_damping,
+                     loop_domain, loop_modes, path_budget, path_extremes, rate_culprit, run_steps, scale_culprit,
+                     slow_rate, steps_domain, within_budget)
 
 __all__ = ["number", "integer", "array", "one_of", "flag", "instance", "options"]
 

@@ -17,7 +17,8 @@ import numpy as np
 
 __all__ = ["loop_modes", "run_steps", "within_budget", "scale_culprit", "by_scale", "heading_damping", "steps_domain",
            "loop_domain", "path_budget", "path_extremes", "MAX_RUN_STEPS", "MAX_ODE_STEPS", "STEPS_PER_RADIAN",
-           "MAX_STEPS", "MAX_DAMPING_PERIODS", "RK4_REACH"]
+           "MAX_STEPS", "MAX_DAMPING_PERIODS", "RK4_REACH", "slow_rate", "grid_budget", "MAX_GRID_POINTS", "H_DAMP",
+           "MAX_SAMPLES", "rate_culprit"]
 
 #: the most steps an explicit adaptive run (:func:`lib.simulate.simulate`) may be expected to take,
 #: at about 1.3 ms a step of DOP853 on the closed loop in Python, about a minute of CPU
@@ -32,6 +33,11 @@ MAX_ODE_STEPS = 1e6
 #: the most fixed steps a reference period may need in a sweep over (R, Theta) (beyond, a point
 #: costs minutes, R far beyond the body's scale, or Theta far below its rates)
 MAX_STEPS = 2 ** 14
+#: the most points a map over an n x n grid may hold (Fig. 5's 100 x 100 takes about 20 s of CPU, 2 ms a
+#: point: 250 000 points, n = 500, take about 10 minutes on one core)
+MAX_GRID_POINTS = 250_000
+#: the most samples of a run's default output grid (each sample holds 18 numbers: about 300 MB)
+MAX_SAMPLES = 2_000_000
 #: the most reference periods the heading's damping time I_C / c_phi may last in a verdict
 #: (their transients run 16 to 48 periods, so a start is forgotten before the orbit search begins)
 MAX_DAMPING_PERIODS = 8.0
@@ -182,6 +188,90 @@ def by_scale(body, R, Theta, need, names=("R", "Theta")) -> dict:
     return {names[0]: np.where(by_r, need, 0), names[1]: np.where(by_r, 0, need)}
 
 
+def rate_culprit(body, Theta, mode) -> np.ndarray:
+    """Whether a cost set by a rate Theta (rad/s) and a mode ``mode`` (1/s, complex) together, as
+    the steps a period T = 2 pi / |Theta| of a mode, lies on Theta: where Theta lies farther from
+    the body's rate c_phi / I_C than the mode does, on a log scale (a slow path, not stiff gains).
+
+    Parameters
+    ----------
+    body : Body
+        The body (duck-typed: c_phi, I).
+    Theta : array_like
+        Rates (rad/s), non-zero.
+    mode : complex or array_like
+        The mode's eigenvalue (1/s).
+
+    Returns
+    -------
+    numpy.ndarray
+        True where Theta is the culprit, one per point.
+    """
+    rate = body.c_phi / body.I
+    t = np.abs(np.log(np.abs(np.asarray(Theta, float)) / rate))
+    m = np.abs(np.log(np.maximum(np.abs(np.asarray(mode, complex)), 1e-300) / rate))
+    return t > m
+
+
+#: the bound on h c_phi / (I_C Theta), the heading's damping over one step of the phase s = Theta t, of the
+#: rotation's verdict map (:func:`lib.rotation.engine.check_domain`, ``h_lambda``)
+H_DAMP = 0.125
+
+
+def slow_rate(body, Theta, name: str = "Theta") -> None:
+    """Refuse a rate Theta (rad/s) so far below the body's rate c_phi / I_C that the heading's damping
+    alone asks more than :data:`MAX_STEPS` fixed steps a reference period of the rotation's verdict
+    map (h A <= :data:`H_DAMP`, A = c_phi / (I_C Theta)): the floor of Fig. 5's verdicts
+    (:func:`lib.rotation.verdicts.eight_rotation_sweep` refuses the same rates), for a verdict on
+    the heading that does not step (the law for P's exact map).
+
+    Parameters
+    ----------
+    body : Body
+        The body (duck-typed: I, c_phi).
+    Theta : float or array_like
+        Rates (rad/s).
+    name : str
+        The argument's name in the message.
+
+    Raises
+    ------
+    ValueError
+        Naming the first rate outside, and the domain.
+    """
+    Theta = np.atleast_1d(np.asarray(Theta, float))
+    need = 2 * np.pi * body.c_phi / (body.I * np.abs(Theta) * H_DAMP)
+    floor = 2 * np.pi * body.c_phi / (body.I * H_DAMP * MAX_STEPS)
+    floor = float(np.ceil(floor / 10 ** np.floor(np.log10(floor) - 2)) * 10 ** np.floor(np.log10(floor) - 2))
+    within_budget({name: need}, MAX_STEPS, what="a period would need", unit="fixed steps (the heading's damping "
+                  f"alone, at h c_phi / (I_C Theta) <= {H_DAMP:g})", values={name: (Theta, "rad/s")},
+                  fix=f"outside the verdicts' domain (Theta far below the body's rates: the heading's verdicts need "
+                  f"|{name}| >= {floor:g} rad/s)")
+
+
+def grid_budget(n: int, name: str = "n") -> None:
+    """Refuse an n x n map (an int n, checked) holding more than :data:`MAX_GRID_POINTS` points,
+    before any array of it is built, naming ``name``.
+
+    Parameters
+    ----------
+    n : int
+        Points per side.
+    name : str
+        The argument's name in the message.
+
+    Raises
+    ------
+    ValueError
+        Naming n, the points and the largest n.
+    """
+    side = int(np.floor(np.sqrt(MAX_GRID_POINTS)))
+    if n > side:
+        raise ValueError(f"{name} = {n}: an {name} x {name} grid would hold {float(n) ** 2:.3g} points, beyond the "
+                         f"budget of {MAX_GRID_POINTS} (at about 2 ms a point, 10 minutes of CPU); use {name} <= "
+                         f"{side}, or sweep the points you need")
+
+
 #: the largest h |lambda| of a fixed-step sweep's RK4 step (its stability reaches about 2.8)
 RK4_REACH = 2.5
 
@@ -215,9 +305,10 @@ def heading_damping(body, Theta, name: str = "Theta") -> None:
 
 def steps_domain(steps, damping_steps, R, Theta) -> None:
     """Refuse the first point (R_i (m), Theta_i (rad/s)) whose fixed ``steps`` a period exceed
-    :data:`MAX_STEPS`, naming Theta where the damping alone asks for half of them or more
-    (``damping_steps``: a rate far below the body's) and R elsewhere (a path far beyond the body's
-    scale).
+    :data:`MAX_STEPS`, naming Theta where the damping alone asks for a quarter of them or more
+    (``damping_steps``: a rate far below the body's; the steps are rounded up to a power of 2, up to
+    twice the exact need, so this is the damping at about half the need or more) and R elsewhere (a
+    path far beyond the body's scale).
 
     Parameters
     ----------
@@ -232,19 +323,21 @@ def steps_domain(steps, damping_steps, R, Theta) -> None:
         Naming R or Theta and the index.
     """
     steps = np.asarray(steps, float)
-    by_theta = np.asarray(damping_steps, float) >= steps / 2
+    by_theta = np.asarray(damping_steps, float) >= steps / 4
     within_budget({"R": np.where(by_theta, 0, steps), "Theta": np.where(by_theta, steps, 0)}, MAX_STEPS,
                   what="a period would need", unit="fixed steps", values={"R": (R, "m"), "Theta": (Theta, "rad/s")},
                   fix="outside the verdicts' domain (R far beyond the body's scale, or Theta far below its rates)")
 
 
-def loop_domain(body, gains, kin, R, Theta, *, heading_gains: bool = True) -> None:
+def loop_domain(body, gains, kin, R, Theta, *, heading_gains: bool = True, names=("R", "Theta")) -> None:
     """The domain of a sweep of the full closed loop over points (R_i (m), Theta_i (rad/s)) on the
     path ``kin`` (``kin(R, Theta, t)`` -> (z_d, dz_d, ddz_d), :data:`lib.trajectories.KINEMATICS`):
     the heading's damping time at most :data:`MAX_DAMPING_PERIODS` periods (``Theta``), and the
     fixed steps a period that its fastest mode (:func:`loop_modes`: the gains', or the heading's
     driven by the path, laid on R or Theta by :func:`scale_culprit`) needs for RK4, h |lambda| <=
-    :data:`RK4_REACH`, at most :data:`MAX_STEPS`. Refuses the first point outside, naming it.
+    :data:`RK4_REACH`, at most :data:`MAX_STEPS`. The gains' cost is laid on Theta where Theta lies
+    farther from the body's rate than the gains' mode does (:func:`rate_culprit`: a long period, not
+    stiff gains). Refuses the first point outside, naming it.
 
     Parameters
     ----------
@@ -259,6 +352,8 @@ def loop_domain(body, gains, kin, R, Theta, *, heading_gains: bool = True) -> No
         The points (N,), checked.
     heading_gains : bool
         Whether the allocation uses the heading's gains (w_phi > 0 somewhere).
+    names : tuple of str
+        How the caller names R and Theta (``("ref.R", "ref.theta")`` for a reference).
 
     Raises
     ------
@@ -267,15 +362,18 @@ def loop_domain(body, gains, kin, R, Theta, *, heading_gains: bool = True) -> No
     """
     R, Theta = np.atleast_1d(np.asarray(R, float)), np.atleast_1d(np.asarray(Theta, float))
     T = 2 * np.pi / np.abs(Theta)
-    heading_damping(body, Theta)
+    heading_damping(body, Theta, names[1])
     _, dz, ddz = kin(R[:, None], Theta[:, None], np.linspace(0.0, 1.0, 65)[None, :] * T[:, None])
     modes = loop_modes(body, gains, speed=np.hypot(dz[..., 0], dz[..., 1]).max(axis=1),
                        accel=np.hypot(ddz[..., 0], ddz[..., 1]).max(axis=1), heading_gains=heading_gains)
-    need = by_scale(body, R, Theta, T * np.abs(modes["ref"]) / RK4_REACH)
+    need = by_scale(body, R, Theta, T * np.abs(modes["ref"]) / RK4_REACH, names)
     if gains is not None:
-        need["gains"] = T * abs(modes["body and gains"]) / RK4_REACH
+        on_theta = rate_culprit(body, Theta, modes["body and gains"])
+        g = T * abs(modes["body and gains"]) / RK4_REACH
+        need[names[1]] = np.maximum(need[names[1]], np.where(on_theta, g, 0))
+        need["gains"] = np.where(on_theta, 0, g)
     within_budget(need, MAX_STEPS, what="a period would need", unit="fixed steps",
-                  values={"R": (R, "m"), "Theta": (Theta, "rad/s")},
+                  values={names[0]: (R, "m"), names[1]: (Theta, "rad/s")},
                   fix="outside the sweep's domain (stiff gains, R far beyond the body's scale or Theta far "
                   "from its rates)")
 

@@ -40,16 +40,26 @@ MAX_EXPONENT = 100.0
 
 
 def _check_domain(body: Body, kind: str, R, Theta, steps: int) -> None:
-    """Refuse a point whose heading turns so fast per period that ``steps`` Magnus steps would each
-    carry an exponent above :data:`MAX_EXPONENT` (the flow's matrix S grows as R Theta / eps and
-    R (c / m) / eps), naming R or Theta, whichever lies farther from the body's scales."""
+    """Refuse a point outside the verdicts' domain: a rate below Fig. 5's floor
+    (:func:`lib.machinery.domain.slow_rate`, as :func:`lib.rotation.verdicts.eight_rotation_sweep`),
+    or a heading that turns so fast per period that more than :data:`lib.machinery.domain.MAX_STEPS`
+    Magnus steps would be needed for each to carry an exponent at most :data:`MAX_EXPONENT` (the
+    flow's matrix S grows as R Theta / eps and R (c / m) / eps), naming R or Theta, whichever lies
+    farther from the body's scales; then a point that needs more than ``steps``, naming the option
+    ``steps`` and the count that every point needs."""
+    checks.slow_rate(body, Theta)
     eng = HeadingEngine(kind, 64)
     cA, cV = coefficients(body, R, Theta)
     rate = np.abs(cA) * np.hypot(eng.eX2, eng.eY2).max() + np.abs(cV) * np.hypot(eng.eX1, eng.eY1).max()
-    checks.within_budget(checks.by_scale(body, R, Theta, 2 * np.pi * rate / MAX_EXPONENT), steps,
-                         what="a period would need", unit=f"Magnus steps (each step's exponent <= {MAX_EXPONENT:g})",
-                         values={"R": (R, "m"), "Theta": (Theta, "rad/s")},
-                         fix="raise the option steps, or keep R and Theta near the body's scales")
+    need = 2 * np.pi * rate / MAX_EXPONENT
+    unit = f"Magnus steps (each step's exponent <= {MAX_EXPONENT:g})"
+    values = {"R": (R, "m"), "Theta": (Theta, "rad/s")}
+    checks.within_budget(checks.by_scale(body, R, Theta, need), checks.MAX_STEPS, what="a period would need",
+                         unit=unit, values=values,
+                         fix="outside the verdicts' domain (R far beyond the body's scale, or Theta far from its rates)")
+    checks.within_budget(checks.by_scale(body, R, Theta, need), steps, what="a period would need", unit=unit,
+                         values=values, fix=f"raise the option steps to {int(np.ceil(np.max(need)))} (steps={steps} "
+                         "given)")
 
 
 def _options(options: dict) -> dict:
@@ -132,6 +142,7 @@ def percussion_fig5_map(body: Body, R_range=FIG5_GRID["R"], Theta_range=FIG5_GRI
         n^2 rows.
     """
     n = checks.integer("n", n, minimum=2)
+    checks.grid_budget(n)
     R, Th = np.meshgrid(np.linspace(*R_range, n), np.linspace(*Theta_range, n))
     return heading_sweep(body, R.ravel(), Th.ravel(), **kw)
 

@@ -30,7 +30,7 @@ from ..machinery import checks
 from ..allocation import Limits
 from ..closed_loop import _paper_rows_tabled
 from ..dynamics import verdicts as dv
-from ..weighting.verdicts import _PeriodFlow, _decide, _loop_options, _observe, _start
+from ..weighting.verdicts import _PeriodFlow, _check_steps, _decide, _loop_options, _observe, _start
 from ..machinery.parallel import concat_frames, map_chunks
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from ..trajectories import KINEMATICS
@@ -254,6 +254,7 @@ def mismatch_sweep(body: Body, gains: Gains, kind, R, Theta, mismatch: Mapping, 
     o = _loop_options(options)
     for k in set(kinds.tolist()):                 # the domain before any run (issue 37)
         checks.loop_domain(body, gains, KINEMATICS[k], R[kinds == k], Theta[kinds == k], heading_gains=False)
+    _check_steps(body, gains, R, Theta, o["steps"])     # the RK4 steps follow the error dynamics, or refused
     parts = map_chunks(_sweep_chunk, N, (kinds, R, Theta, scale),
                        dict(body=body, gains=gains, z0=z0, dz0=dz0, o=o), executor, chunk_size)
     return concat_frames(parts)

@@ -7,6 +7,39 @@ This module supplies the period map (``_PeriodFlow``: all points in lockstep by
 the batch RK4 in the normalised time tau = t / T) and what the closed loop reports
 beyond the verdict: the position's drift and whether it is held.
 
+The procedure of :func:`closed_loop_verdicts`. All points run together by the batch RK4
+(:mod:`lib.integrators.batch`) in tau = t / T (``steps`` per reference period T = 2 pi / |Theta|,
+128), so that the stroboscopic section of each point, its error state e = s - s_d (x, y, p, and
+rates; p = phi - phi_d unwrapped) at t = j T, falls on a step (:data:`LOOP_VERDICT_DEFAULTS`):
+
+1. ``transient`` periods (32), then ``periods`` (72) more with a companion trajectory
+   (Benettin: started ``d0`` away, renormalised every period): the largest Lyapunov
+   exponent lambda T per period, with its standard error from the means of blocks of
+   ``block`` (12) periods; the drift of p (turns per period) and of the mean position
+   error (m per period), each with its batch-means standard error; ranges and RMS values.
+2. Periodic orbit: where the last two section states repeat within ``candidate_tol`` at a
+   lag k <= ``max_period`` (8), up to n whole turns of p, Newton on P^k(e) = e + 2 pi n e_p
+   with a forward-difference Jacobian (residual <= ``newton_tol``); the orbit attracts when
+   every Floquet multiplier (eigenvalue of DP^k) lies inside the unit circle, and is reached
+   when the last section state is within ``reach_tol`` of one of its k points and has closed
+   in over the last periods no slower than the slowest multiplier allows. Verdict
+   ``periodic`` (n = 0) or ``slipping`` (n != 0). Whole turns are allowed only where
+   w_phi = 0: there the loop does not see p beyond phi modulo 2 pi; with w_phi > 0, (23)
+   demands a torque from the unwrapped p, so a state a whole turn on is a different state.
+3. Otherwise, as in Chapter 5: ``chaotic`` when lambda T > max(3 SE, ``lyapunov_band``);
+   ``quasiperiodic`` when |lambda T| <= band, SE <= band / 3 and the (p, dp/dt) section
+   closes on itself (:func:`lib.dynamics.verdicts.section_returns` <= ``return_tol``);
+   else ``undecided`` with a reason.
+
+``lost`` (the heading, :func:`lib.dynamics.verdicts.heading_lost`): slipping, or no orbit
+and |drift of p| > 3 SE + ``slip_band`` (1e-3 turns per period); ``turns_round`` the other
+reading (range of p above 2 pi: over the last block on an orbit, over the observed periods
+otherwise). ``position_lost``: no orbit and either the mean position error grows by more
+than 3 SE + ``position_band`` (1e-3 m per period) or, over the last block, the body is
+farther from its reference point than the radius R of the path itself; or the state became
+non-finite. ``tracked``: the position is not lost and its largest error over the last block
+is at most ``position_tol`` R (0.1 R: the body stays on the path it is asked to follow).
+
 Units: R in m, Theta in rad/s, angles in rad, times in s; drifts per reference period.
 """
 
@@ -228,49 +261,23 @@ def closed_loop_verdicts(body: Body, gains: Gains, kind: str, R, Theta, weights=
     six-state closed loop (2)-(4), (23) with the weighted allocation (weights (w_x, w_y, w_phi) per
     point; w_phi = 0 is exactly the paper's law (25)-(26)), on ``kind`` ("eight" (28) or "circle"
     (27)) at the points (R_i (m), Theta_i (rad/s)), from z0, dz0 ((3,) or (N, 3); default: on the
-    reference), for any weights: one criterion for both laws.
+    reference), for any weights: one criterion for both laws, by the procedure of the module's
+    docstring (:mod:`lib.weighting.verdicts`: the run, the orbit, the exponent, ``lost``,
+    ``position_lost`` and ``tracked``).
 
-    All points run together by the batch RK4 (:mod:`lib.integrators.batch`) in the normalised
-    time tau = t / T (``steps`` per reference period T = 2 pi / |Theta|, 128), so that the
-    stroboscopic section of each point, its error state e = s - s_d (x, y, p, and rates; p =
-    phi - phi_d unwrapped) at t = j T, falls on a step.
-
-    1. ``transient`` periods (32), then ``periods`` (72) more with a companion trajectory
-       (Benettin: started ``d0`` away, renormalised every period): the largest Lyapunov
-       exponent lambda T per period, with its standard error from the means of blocks of
-       ``block`` (12) periods; the drift of p (turns per period) and of the mean position
-       error (m per period), each with its batch-means standard error; ranges and RMS values.
-    2. Periodic orbit: where the last two section states repeat within ``candidate_tol`` at a
-       lag k <= ``max_period`` (8), up to n whole turns of p, Newton on P^k(e) = e + 2 pi n e_p
-       with a forward-difference Jacobian (residual <= ``newton_tol``); the orbit attracts when
-       every Floquet multiplier (eigenvalue of DP^k) lies inside the unit circle, and is reached
-       when the last section state is within ``reach_tol`` of one of its k points and has closed
-       in over the last periods no slower than the slowest multiplier allows. Verdict
-       ``periodic`` (n = 0) or ``slipping`` (n != 0). Whole turns are allowed only where
-       w_phi = 0: there the loop does not see p beyond phi modulo 2 pi; with w_phi > 0, (23)
-       demands a torque from the unwrapped p, so a state a whole turn on is a different state.
-    3. Otherwise, as in Chapter 5: ``chaotic`` when lambda T > max(3 SE, ``lyapunov_band``);
-       ``quasiperiodic`` when |lambda T| <= band, SE <= band / 3 and the (p, dp/dt) section
-       closes on itself (:func:`lib.dynamics.verdicts.section_returns` <= ``return_tol``);
-       else ``undecided`` with a reason.
-
-    ``lost`` (the heading, :func:`lib.dynamics.verdicts.heading_lost`): slipping, or no orbit
-    and |drift of p| > 3 SE + ``slip_band`` (1e-3 turns per period); ``turns_round`` the other
-    reading (range of p above 2 pi: over the last block on an orbit, over the observed periods
-    otherwise). ``position_lost``: no orbit and either the mean position error grows by more
-    than 3 SE + ``position_band`` (1e-3 m per period) or, over the last block, the body is
-    farther from its reference point than the radius R of the path itself; or the state became
-    non-finite. ``tracked``: the position is not lost and its largest error over the last block
-    is at most ``position_tol`` R (0.1 R: the body stays on the path it is asked to follow).
+    Before any run, the points are checked against the sweep's domain
+    (:func:`lib.machinery.domain.loop_domain`) and against the option ``steps``: a point whose
+    error dynamics (23)-(24) turn faster than ``steps`` RK4 steps a period can follow is refused,
+    naming the gains (or Theta, where a slow rate sets the cost), as :func:`lib.simulate.simulate`
+    refuses them, rather than reported as a run that diverged.
 
     Scale-out: with an ``executor`` (any :class:`concurrent.futures.Executor`) the points go to
     it in consecutive chunks of ``chunk_size`` (default: two chunks per worker; without an
     executor, ``chunk_size`` runs the chunks here one after another), by
-    :func:`lib.machinery.parallel.map_chunks`. The field (lean or through :class:`ClosedLoop`) is chosen
-    once for all points of the call and every point is decided on its own, so the frame is
-    the one of the single call.
-    ``progress``: a bar over the points on stderr (:func:`lib.machinery.parallel.show_progress`;
-    default None: only when run interactively, never under pytest or in the book build).
+    :func:`lib.machinery.parallel.map_chunks`. The field (lean or through :class:`ClosedLoop`) is
+    chosen once for all points of the call and every point is decided on its own, so the frame is
+    the one of the single call. ``progress``: a bar over the points on stderr
+    (:func:`lib.machinery.parallel.show_progress`; default None: only when run interactively).
 
     Parameters
     ----------
@@ -313,6 +320,17 @@ def closed_loop_verdicts(body: Body, gains: Gains, kind: str, R, Theta, weights=
         p_rms (rad, RMS of p wrapped to (-pi, pi], last block), pos_rms, pos_max (m, last block;
         NaN where the run diverged), periods, reason.
     """
+    kinds, R, Theta, w, limits, o = _checked_points(body, gains, kind, R, Theta, weights, allocation, limits, options)
+    starts = [_start_array(name, v, R.size) for name, v in (("z0", z0), ("dz0", dz0))]
+    parts = map_chunks(_verdict_chunk, R.size, (kinds, R, Theta, w, *starts),
+                       dict(body=body, gains=gains, allocation=allocation, limits=limits, o=o,
+                            lean=_lean(allocation, limits, w)), executor, chunk_size, progress)
+    return concat_frames(parts)
+
+
+def _checked_points(body, gains, kind, R, Theta, weights, allocation, limits, options):
+    """The arguments of :func:`closed_loop_verdicts` checked, and the points inside the domain, before
+    any run: (kinds, R, Theta, weights (N, 3), limits, options)."""
     kinds = np.atleast_1d(np.asarray(kind, dtype=object))
     if kinds.ndim != 1 or kinds.size == 0:
         raise ValueError(f"kind must be 'circle', 'eight' or a 1-D array of them, got {kind!r}")
@@ -327,21 +345,36 @@ def closed_loop_verdicts(body: Body, gains: Gains, kind: str, R, Theta, weights=
     for k in set(kinds.tolist()):                 # the domain before any run (issue 37)
         checks.loop_domain(body, gains, KINEMATICS[k], R[kinds == k], Theta[kinds == k],
                            heading_gains=bool(np.any(w[:, 2] > 0)))
-    N = R.size
-    starts = []
-    for name, v in (("z0", z0), ("dz0", dz0)):
-        if v is not None:
-            v = checks.array(name, v)
-            try:
-                v = np.broadcast_to(v, (N, 3))
-            except ValueError:
-                raise ValueError(f"{name} must have shape (3,) or ({N}, 3), got {np.shape(v)}") from None
-        starts.append(v)
-    w = np.ascontiguousarray(w)
-    parts = map_chunks(_verdict_chunk, N, (kinds, R, Theta, w, *starts),
-                       dict(body=body, gains=gains, allocation=allocation, limits=limits, o=o,
-                            lean=_lean(allocation, limits, w)), executor, chunk_size, progress)
-    return concat_frames(parts)
+    _check_steps(body, gains, R, Theta, o["steps"])
+    return kinds, R, Theta, np.ascontiguousarray(w), limits, o
+
+
+def _check_steps(body, gains, R, Theta, steps: int) -> None:
+    """Refuse a point whose error dynamics on the position, M e'' + (Kv + N) e' + Kp e = 0 of
+    (23)-(24) (:func:`lib.machinery.domain.loop_modes`), turn faster than ``steps`` RK4 steps a
+    reference period follow, h |lambda| <= :data:`lib.machinery.domain.RK4_REACH`: there the run
+    diverges. Names the gains, or Theta where a slow rate sets the cost
+    (:func:`lib.machinery.domain.rate_culprit`), and the steps that every point needs (inside the
+    domain, at most :data:`lib.machinery.domain.MAX_STEPS`)."""
+    mode = checks.loop_modes(body, gains, heading_gains=False)["body and gains"]
+    need = 2 * np.pi / np.abs(Theta) * abs(mode) / checks.RK4_REACH
+    on_theta = checks.rate_culprit(body, Theta, mode)
+    checks.within_budget({"gains": np.where(on_theta, 0, need), "Theta": np.where(on_theta, need, 0)}, steps,
+                         what="a period would need", unit=f"RK4 steps (the error dynamics' fastest rate, about "
+                         f"{abs(mode):.3g} 1/s, at h |lambda| <= {checks.RK4_REACH:g})",
+                         values={"Theta": (Theta, "rad/s")},
+                         fix=f"raise the option steps to {int(np.ceil(need.max()))} (steps={steps} given)")
+
+
+def _start_array(name: str, v, N: int):
+    """A start ``z0`` or ``dz0`` checked, (N, 3), or None."""
+    if v is None:
+        return None
+    v = checks.array(name, v)
+    try:
+        return np.broadcast_to(v, (N, 3))
+    except ValueError:
+        raise ValueError(f"{name} must have shape (3,) or ({N}, 3), got {np.shape(v)}") from None
 
 
 def _verdict_chunk(kinds, R, Theta, w, z0, dz0, *, body, gains, allocation, limits, o, lean) -> pd.DataFrame:
@@ -361,17 +394,11 @@ def _verdict_chunk(kinds, R, Theta, w, z0, dz0, *, body, gains, allocation, limi
 
 
 def _start(flow: _PeriodFlow, z0, dz0) -> np.ndarray:
-    """The initial states (N, 6): on the reference, or z0, dz0 ((3,) or (N, 3))."""
-    N = flow.R.size
-    s0 = flow.reference(np.arange(N), 0.0)
-    for name, v, sl in (("z0", z0, slice(0, 3)), ("dz0", dz0, slice(3, 6))):
+    """The initial states (N, 6): on the reference, or z0, dz0 ((N, 3), checked by :func:`_start_array`)."""
+    s0 = flow.reference(np.arange(flow.R.size), 0.0)
+    for v, sl in ((z0, slice(0, 3)), (dz0, slice(3, 6))):
         if v is not None:
-            try:
-                s0[:, sl] = np.broadcast_to(np.asarray(v, dtype=float), (N, 3))
-            except ValueError:
-                raise ValueError(f"{name} must have shape (3,) or ({N}, 3), got {np.shape(v)}") from None
-    if not np.all(np.isfinite(s0)):
-        raise ValueError("the initial state z0, dz0 must be finite")
+            s0[:, sl] = v
     return s0
 
 
