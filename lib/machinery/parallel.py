@@ -105,7 +105,10 @@ def process_pool(workers: int) -> ProcessPoolExecutor:
 
 
 def _is_main_test(test: ast.expr) -> bool:
-    """Whether an ``if`` test reads ``__name__ == "__main__"`` (either way round)."""
+    """Whether an ``if`` test reads ``__name__ == "__main__"`` (either way round), alone or as
+    one term of an ``and``."""
+    if isinstance(test, ast.BoolOp) and isinstance(test.op, ast.And):
+        return any(_is_main_test(v) for v in test.values)
     if not (isinstance(test, ast.Compare) and len(test.ops) == 1 and isinstance(test.ops[0], ast.Eq)):
         return False
     sides = [test.left, test.comparators[0]]
@@ -115,14 +118,16 @@ def _is_main_test(test: ast.expr) -> bool:
 
 
 def _unguarded_line(path: str, line: int) -> bool:
-    """Whether ``line`` of the script ``path`` lies at its top level outside every
-    ``if __name__ == "__main__":`` block."""
+    """Whether ``line`` of the script ``path``, run at its top level, lies outside every
+    ``if __name__ == "__main__":`` block, at any depth (inside another ``if``, a ``with``, a
+    ``try``: a block that runs only in the main process guards whatever it holds)."""
     try:
         tree = ast.parse(open(path, encoding="utf-8").read())
     except (OSError, SyntaxError, ValueError):
         return False
-    return not any(isinstance(node, ast.If) and _is_main_test(node.test) and node.lineno <= line <= node.end_lineno
-                   for node in tree.body)
+    return not any(isinstance(node, ast.If) and _is_main_test(node.test)
+                   and any(s.lineno <= line <= s.end_lineno for s in node.body)
+                   for node in ast.walk(tree))
 
 
 def _refuse_unguarded_script() -> None:

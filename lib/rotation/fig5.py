@@ -53,9 +53,9 @@ def fig5_map(body: Body, n: int = FIG5_GRID["n"], *, confirm=("perturbed",), los
     body : Body
         The body.
     n : int
-        Points per side (>= 2).
-    confirm : tuple of str
-        Keys of :data:`CONFIRMATIONS`.
+        Points per side (>= 2, at most :data:`lib.machinery.domain.MAX_GRID_POINTS` points in all).
+    confirm : str or tuple of str
+        A key of :data:`CONFIRMATIONS`, or a tuple of them.
     lost_factor : int, optional
         Horizon factor of :func:`confirm_lost`.
     executor, chunk_size, progress
@@ -68,9 +68,9 @@ def fig5_map(body: Body, n: int = FIG5_GRID["n"], *, confirm=("perturbed",), los
         columns of :func:`confirm_attractors` and :func:`confirm_lost`.
     """
     n = checks.integer("n", n, minimum=2)
+    checks.grid_budget(n)              # before the grid is built
     checks.instance("body", body, Body)
-    for key in tuple(confirm):         # the options first, not after the sweep (issue 37)
-        checks.one_of("confirm", key, tuple(CONFIRMATIONS))
+    confirm = _confirmations(confirm)  # the options first, not after the sweep (issue 37)
     if lost_factor is not None:
         checks.integer("lost_factor", lost_factor, minimum=2)
     R, Th = np.meshgrid(np.linspace(*FIG5_GRID["R"], n), np.linspace(*FIG5_GRID["Theta"], n))
@@ -79,6 +79,20 @@ def fig5_map(body: Body, n: int = FIG5_GRID["n"], *, confirm=("perturbed",), los
     if lost_factor is not None:
         frame = confirm_lost(body, "eight", frame, lost_factor)
     return confirm_attractors(body, "eight", frame, confirm)
+
+
+def _confirmations(confirm) -> tuple:
+    """``confirm`` as a tuple of keys of :data:`CONFIRMATIONS`: one key (a str) or a sequence of them."""
+    if isinstance(confirm, str):
+        confirm = (confirm,)
+    try:
+        confirm = tuple(confirm)
+    except TypeError:
+        raise TypeError(f"confirm must be a key of {list(CONFIRMATIONS)} or a tuple of them, got "
+                        f"{type(confirm).__name__} {confirm!r}") from None
+    for key in confirm:
+        checks.one_of("confirm", key, tuple(CONFIRMATIONS))
+    return confirm
 
 
 def _redo(body, kind, frame, rows, opts, *, start=0.0, steps_factor=1, x0=(0.0, 0.0)):
@@ -146,8 +160,8 @@ def confirm_attractors(body: Body, kind: str, frame: pd.DataFrame, confirm=("per
         ``"eight"`` or ``"circle"``.
     frame : pandas.DataFrame
         Verdicts from the reference start.
-    confirm : tuple of str
-        Keys of :data:`CONFIRMATIONS`.
+    confirm : str or tuple of str
+        A key of :data:`CONFIRMATIONS`, or a tuple of them.
     **options
         The procedure's options, as given to the first decision.
 
@@ -157,9 +171,7 @@ def confirm_attractors(body: Body, kind: str, frame: pd.DataFrame, confirm=("per
         The frame, with ``transient`` verdicts and the column ``confirmed``.
     """
     _check_body_kind(body, kind)
-    confirm = tuple(confirm)
-    for key in confirm:
-        checks.one_of("confirm", key, tuple(CONFIRMATIONS))
+    confirm = _confirmations(confirm)
     opts = _verdict_options(options)
     out = frame.copy()
     rows = np.flatnonzero(dv.needs_confirmation(frame.regime, frame.periods, opts["transient"]))

@@ -75,6 +75,10 @@ def run(body: Body, gains: Gains, name: str, R: float, theta: float, n_periods: 
     return simulate(body, gains, ref, t_end, t_eval=np.linspace(0.0, t_end, n + 1), **kw)
 
 
+#: what :func:`steady_mask` and the summaries read of a run (a :class:`lib.simulate.SimulationResult`)
+_RUN_FIELDS = ("t", "z", "z_d", "F", "ref")
+
+
 def steady_mask(res: SimulationResult, n_periods: float) -> np.ndarray:
     """Boolean mask of the samples in the last ``n_periods`` reference periods.
 
@@ -90,8 +94,11 @@ def steady_mask(res: SimulationResult, n_periods: float) -> np.ndarray:
     numpy.ndarray
         One bool per sample.
     """
-    if n_periods <= 0:
-        raise ValueError(f"n_periods must be positive, got {n_periods!r}")
+    missing = [k for k in _RUN_FIELDS if not hasattr(res, k)]
+    if missing:
+        raise TypeError(f"res must be a run of lib.simulate.simulate (a SimulationResult), got "
+                        f"{type(res).__name__}, which has no attribute {', '.join(missing)}")
+    n_periods = checks.number("n_periods", n_periods, positive=True)
     if n_periods * res.ref.period > res.t[-1] - res.t[0] + 1e-9:
         raise ValueError(f"n_periods = {n_periods!r} periods ({n_periods * res.ref.period:g} s) is longer than the run "
                          f"({res.t[-1] - res.t[0]:g} s): the window would hold the transient from the start")
