@@ -111,9 +111,9 @@ def test_a_rate_far_beyond_the_bodys_is_refused_at_once_naming_Theta(call, bad):
     (lambda: percussion.heading_sweep(B, [1e9], [0.5]), r"^R = 1e\+09 m"),
     (lambda: percussion.heading_sweep(B, [1.0], [1e9]), r"^Theta = 1e\+09 rad/s"),
     (lambda: loop_verdicts.closed_loop_verdicts(B, G, "eight", [1.0], [1e9]), r"^Theta = 1e\+09 rad/s"),
-    (lambda: simulate(Body(), Gains(kp=1e6), T.circle(), 8), r"^body and gains: .*method='Radau'"),
+    (lambda: simulate(Body(), Gains(kp=1e6), T.circle(), 8), r"^body and gains: .*oscillates.*t_end <= 5\.65 s$"),
     (lambda: simulate(Body(), Gains(), T.circle(R=1e9), 8), r"^ref \(R = 1e\+09 m"),
-    (lambda: p_simulate(Body(), Gains(kp=1e6), T.circle(), 8), r"^gains and pole: .*method='Radau'"),
+    (lambda: p_simulate(Body(), Gains(kp=1e6), T.circle(), 8), r"^gains and pole: .*oscillates.*t_end <= 5\.65 s$"),
     (lambda: p_simulate(Body(), Gains(), T.circle(R=1e9), 8), r"^ref \(R = 1e\+09 m"),
 ], ids=["P sweep R", "P sweep Theta", "loop verdicts Theta", "simulate kp", "simulate R", "P simulate kp",
         "P simulate R"])

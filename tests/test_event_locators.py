@@ -112,3 +112,17 @@ def test_an_unknown_locator_is_refused():
         L.switched_runs(Body(), Gains(), EIGHT, 0.5, n_periods=1, locator="hermite")
     with pytest.raises(ValueError, match="locator"):
         L.limit_verdicts(Body(), Gains(), EIGHT, [0.5], locator=None)
+
+
+def test_the_dense_locator_places_nearly_every_event_itself_in_a_few_real_steps():
+    # the dense locator's landing stands when a Newton step from it (the event function's real value
+    # over its slope on the continuation) puts the root within T_TOL before it; an event it cannot
+    # place goes to the bracket locator (about ten real steps). On the book's limits the share handed
+    # on was measured at 1.4 % (16 runs' periods, 358 events) and the real steps at 2.2 an event; a
+    # landing test that fails (a wrong Newton step) hands on every event, at 3.8 steps an event
+    runs = L.switched_runs(Body(), Gains(), EIGHT, np.radians([60.0, 90.0, 45.0, 30.0]), [np.inf, np.inf, 4.0, np.inf],
+                           n_periods=4, locator="dense")
+    events, steps, handed_on = runs.locating.sum(axis=0)
+    assert events > 300                                      # reason: the share is taken over many events
+    assert handed_on / events < 0.1                          # measured 0.014; the docstring's "about 3 %"
+    assert steps / events < 3.0                              # measured 2.2; the bracket locator's alone ~10

@@ -503,3 +503,22 @@ def test_a_chaotic_rows_measures_are_taken_on_the_run_it_was_decided_on():
     assert row.drift_stderr == pytest.approx(se[0], rel=0, abs=1e-12)  # accuracy: as the drift's
     # accuracy: the samples include the sections bit for bit; phi_d read at (k S) (T / S), 1e-9
     assert row.p_range >= np.ptp(p) - 1e-9
+
+
+def test_a_demand_within_on_limit_of_a_limit_counts_as_on_it_and_one_farther_inside_does_not():
+    # sliding keeps the demand on the angle limit to rounding, and a capped force on its cap: the census
+    # (lib.limits.switchings.sample_modes) reads a demand within ON_LIMIT of a limit as on it, so that a
+    # run sliding at beta_max - 1e-9 rad is not counted free; a demand 2 ON_LIMIT inside is free
+    from lib.allocation import allocate
+    from lib.limits.switchings import ON_LIMIT, sample_modes
+    from lib.params import PAPER_DZ0, PAPER_Z0
+    body, gains, ref = Body(), Gains(), T.eight()
+    t = np.array([0.3, 1.7])
+    states = np.array([np.r_[PAPER_Z0, PAPER_DZ0], np.r_[PAPER_Z0, PAPER_DZ0] + 0.1])
+    F, beta = allocate(computed_torque(body, gains, ref, t, states[:, :3], states[:, 3:]), states[:, 2])
+    assert np.all(np.abs(beta) > 10 * ON_LIMIT) and np.all(F > 10 * ON_LIMIT)   # reason: demands away from 0
+    for i in range(2):
+        b, f = abs(beta[i]), F[i]
+        on = sample_modes(body, gains, ref, t[i:i + 1], states[i:i + 1], b + 0.5 * ON_LIMIT, f + 0.5 * ON_LIMIT)
+        inside = sample_modes(body, gains, ref, t[i:i + 1], states[i:i + 1], b + 2 * ON_LIMIT, f + 2 * ON_LIMIT)
+        assert on[0] == int(np.sign(beta[i])) + 3 and inside[0] == 0

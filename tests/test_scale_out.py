@@ -191,20 +191,24 @@ from lib.machinery.parallel import map_in_processes
 """
 
 
-@pytest.mark.parametrize("guarded", [False, True])
+@pytest.mark.parametrize("guarded", [False, True, "nested", "not a guard"])
 def test_worker_processes_from_an_unguarded_script_fail_at_once_naming_the_fix(tmp_path, guarded):
     # spawned workers import the script again: without the guard its body would run in each of
-    # them and multiprocessing would print pages of "bootstrapping phase" tracebacks
+    # them and multiprocessing would print pages of "bootstrapping phase" tracebacks. A guard
+    # inside another block guards too (issue 52); a test that only mentions __main__ does not
     import subprocess
     import sys
     call = "print(map_in_processes(math.sqrt, [1.0, 4.0, 9.0], workers=2))"
-    body = f'if __name__ == "__main__":\n    {call}' if guarded else call
+    body = {False: call, True: f'if __name__ == "__main__":\n    {call}',
+            "nested": f'if math.pi > 3:\n    if __name__ == "__main__":\n        {call}',
+            "not a guard": f'if __name__ != "__main__" or math.pi > 3:\n    {call}'}[guarded]
     script = tmp_path / "sweep.py"
     script.write_text(_SCRIPT.format(body=body))
     out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120)
-    if guarded:
+    if guarded in (True, "nested"):
         assert out.returncode == 0 and out.stdout.strip() == "[1.0, 2.0, 3.0]", out.stderr
     else:
+        line = 4 if guarded is False else 5
         assert out.returncode != 0
-        assert 'if __name__ == "__main__":' in out.stderr and "sweep.py, line 4" in out.stderr
+        assert 'if __name__ == "__main__":' in out.stderr and f"sweep.py, line {line}" in out.stderr
         assert "bootstrapping" not in out.stderr and out.stderr.count("Traceback") == 1
