@@ -72,16 +72,19 @@ STATIC_PLOTLY = """async () => {
   return divs.length;
 }"""
 
-#: the figures the printed page holds: every image in the book's content (the matplotlib figures,
-#: the interactive figures' PNGs) and the figure environments they sit in
+#: what the printed page holds: every image in the book's content (the matplotlib figures, the
+#: animations' first frames, the interactive figures' PNGs) and the figure environments; the math
+#: nodes of Sphinx (``.math``) and those MathJax left untypeset (no ``mjx-container`` inside)
 COUNT_FIGURES = """() => {
   const main = document.querySelector('main') || document.body;
-  const imgs = Array.from(main.querySelectorAll('img')).filter(i => i.naturalWidth > 0);
-  return {images: imgs.length,
-          broken: Array.from(main.querySelectorAll('img')).filter(i => !i.naturalWidth).map(i => i.src),
+  const all = Array.from(main.querySelectorAll('img'));
+  const nodes = Array.from(main.querySelectorAll('.math'));
+  return {images: all.filter(i => i.naturalWidth > 0).length,
+          broken: all.filter(i => !i.naturalWidth).map(i => i.src.slice(0, 200)),
           figures: main.querySelectorAll('figure').length,
           math: document.querySelectorAll('mjx-container').length,
-          rawMath: (main.innerText.match(/\\\\\\(|\\\\\\[|\\$\\$/g) || []).length};
+          mathNodes: nodes.length,
+          untypeset: nodes.filter(n => !n.querySelector('mjx-container')).map(n => n.textContent.slice(0, 80))};
 }"""
 
 #: for print: the theme's navigation hidden, the content the full width; each page of the book
