@@ -12,7 +12,7 @@ starts (the problem is not convex; the result is the best found), :func:`verify_
 Defaults and cost: 80 intervals of degree-3 Legendre collocation (2080 unknowns), starts "paper",
 "force", "shifted+-" and, under a cap alone, "convex"; a solve takes about 0.3 to 1.3 s of CPU.
 The inputs are held in the body's frame on each interval, so the force turns with the heading
-within it; under the 4 N cap alone the heading swings up to about 0.3 rad an interval at 80
+within it; under the 4 N cap alone the heading turns by up to about 0.6 rad an interval at 80
 intervals, and the best found RMS error falls as h^2 with the mesh towards the convex optimum
 (0.0731, 0.0700, 0.0692 m at 80, 160, 320 intervals; every start, the convex one included, ends
 in the same optimum). Under an angle limit without a cap the optimum asks for force pulses
