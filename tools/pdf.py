@@ -2,20 +2,23 @@
 
 Two steps:
 
-1. ``jupyter-book build --builder singlehtml .`` writes the book as one HTML page into
+1. ``jupyter-book build --builder singlehtml -n .`` writes the book as one HTML page into
    ``_build/singlehtml``. It reads every notebook page's outputs from the execution cache that
    ``make book`` filled (``execute_notebooks: cache`` in ``_config.yml``); a page missing from
    that cache is executed by this build, one after another, as a bare ``jupyter-book build``
-   would. The cache is neither emptied nor rebuilt here.
+   would. The cache is neither emptied nor rebuilt here. ``-n`` as ``make book``'s build: the
+   two share Sphinx's environment (``_build/.doctrees``), which a change of configuration would
+   make Sphinx read again.
 2. Debian's ``chromium``, driven by Playwright with the browser test's offline flags, opens that
    page from a server on the loopback address, waits until MathJax has typeset the math and every
    image has loaded, replaces each interactive plotly figure (:mod:`lib.figures.interactive`) by a
    PNG of itself (``Plotly.toImage``: the static image a printed page needs, and one that
    ``pdfimages`` counts), and prints the page to A4 with page numbers.
 
-Output: ``_build/pdf/book.pdf`` (``--out``), and beside it ``figures.json``, how many figures
-the printed HTML held (images and interactive figures), which ``tests/test_pdf.py`` compares with
-the images of the PDF. ``--no-build`` prints the existing ``_build/singlehtml`` again.
+Output: ``_build/pdf/book.pdf`` (``--out``), and beside it ``figures.json``, what the printed
+HTML held (images, interactive figures, typeset formulas and any math left untypeset), which
+``tests/test_pdf.py`` compares with the PDF. ``--no-build`` prints the existing
+``_build/singlehtml`` again; ``--root`` names another copy of the book.
 """
 
 from __future__ import annotations
@@ -107,7 +110,7 @@ PRINT_CSS = """
 
 
 def build_singlehtml(root: Path, log: Path) -> int:
-    """Run ``jupyter-book build --builder singlehtml --keep-going .`` in ``root``; its output
+    """Run ``jupyter-book build --builder singlehtml -n --keep-going .`` in ``root``; its output
     to ``log``.
 
     Parameters
@@ -125,7 +128,7 @@ def build_singlehtml(root: Path, log: Path) -> int:
     exe = Path(sys.executable).with_name("jupyter-book")
     log.parent.mkdir(parents=True, exist_ok=True)
     with open(log, "w") as out:
-        proc = subprocess.run([str(exe), "build", "--builder", "singlehtml", "--keep-going", "."],
+        proc = subprocess.run([str(exe), "build", "--builder", "singlehtml", "-n", "--keep-going", "."],
                               cwd=root, stdout=out, stderr=subprocess.STDOUT, text=True)
     return proc.returncode
 
