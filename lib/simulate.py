@@ -28,7 +28,8 @@ from .params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from .trajectories import Circle, Eight, Reference
 
 __all__ = ["SimulationError", "SimulationResult", "simulate", "Integration", "simulate_open_loop",
-           "open_loop_comparison", "OPEN_LOOP_FORMS", "DEFAULT_RTOL", "DEFAULT_ATOL", "run_budget"]
+           "open_loop_comparison", "OPEN_LOOP_FORMS", "DEFAULT_RTOL", "DEFAULT_ATOL", "run_budget", "default_times",
+           "IMPLICIT_STEPS_PER_RADIAN"]
 
 #: the default tolerances of :class:`Integration`
 DEFAULT_RTOL = Integration.rtol
@@ -98,9 +99,10 @@ def _instance(name: str, value, cls):
 EXPLICIT_METHODS = ("RK23", "RK45", "DOP853")
 
 
-#: an implicit method's cost of one radian of an oscillating mode, counted in :data:`lib.machinery.domain.MAX_RUN_STEPS`'
-#: steps (measured on the closed loop: Radau 4 to 31 ms a radian, DOP853's ten steps 0.3 to 1.2 ms; at 30 the
-#: budget holds a Radau run to about 40 s of CPU); a decaying mode costs it nothing (Radau is L-stable)
+#: an implicit method's cost of one radian of an oscillating mode, counted in the steps of
+#: :data:`lib.machinery.domain.MAX_RUN_STEPS` (measured on the closed loop: Radau 4 to 31 ms a
+#: radian, DOP853's ten steps 0.3 to 1.2 ms; at 30 the budget holds a Radau run to about 40 s of
+#: CPU); a decaying mode costs it nothing (Radau is L-stable)
 IMPLICIT_STEPS_PER_RADIAN = 30.0
 
 

@@ -143,6 +143,6 @@ def test_a_stiff_method_is_advised_only_where_it_would_be_inside_the_budget_and_
 
 def test_a_bad_force_limit_is_named_by_its_argument_and_index():
     _refused(lambda: limit_verdicts(B, G, T.eight(), [1.0], force_limits=-1),
-             r"^force_limits must be positive \(N\), or inf or None for none, got -1\.0$")
+             r"^force_limits must be positive \(N\), or inf or None for no force limit, got -1\.0$")
     _refused(lambda: limit_verdicts(B, G, T.eight(), [1.0, 1.0], force_limits=[2.0, -1.0]),
              r"^force_limits\[1\] must be positive")

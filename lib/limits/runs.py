@@ -100,7 +100,8 @@ def _limits_arrays(angle_limits, force_limits):
     if np.any(np.isnan(f)) or not np.all(f > 0):
         i = int(np.flatnonzero(np.isnan(f) | ~(f > 0))[0])
         where = f"[{i}]" if np.ndim(force_limits) else ""
-        raise ValueError(f"force_limits{where} must be positive (N), or inf or None for none, got {float(f[i])!r}")
+        raise ValueError(f"force_limits{where} must be positive (N), or inf or None for no force limit, "
+                         f"got {float(f[i])!r}")
     return b.copy(), f.copy()
 
 
