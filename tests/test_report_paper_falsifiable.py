@@ -139,7 +139,7 @@ def test_lie_bracket_row_needs_every_errata_row_of_its_group(monkeypatch):
 
 @pytest.mark.parametrize("dev, status", [(0.0, "reproduced"), (0.99e-7, "reproduced"), (1e-7, "not reproducible")])
 def test_configuration_form_row_needs_the_two_forms_to_agree(monkeypatch, dev, status):
-    got = _status(monkeypatch, "eq2-4", _open_loop_deviations=lambda: {"state": dev, "printed": 1.0})[0]
+    got = _status(monkeypatch, "eq2-4", open_loop_deviations=lambda: {"state": dev, "printed": 1.0})[0]
     assert got == status
 
 

@@ -28,7 +28,8 @@ from ..trajectories import eight
 from . import studies
 from .extensions import R0, THETA0, fig5_readings, mirror_gap
 from .outcomes import Outcome
-from .report import SWEEP_DEG, _angle_sweep, open_loop_gap, outcome
+from .report import SWEEP_DEG, _angle_sweep, outcome
+from .studies import open_loop_gap
 
 __all__ = ["FINDINGS", "LABELS", "findings", "front_page"]
 

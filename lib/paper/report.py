@@ -8,13 +8,10 @@ that the computed status is the one the book reports (``Item.expected``), so a
 regression changes the page and fails the tests.
 
 The statuses (:data:`STATUSES`) and the rule that gives them are
-:func:`lib.paper.outcomes.legend_status`: a confirmed errata row on a row's equations
-(:func:`errata_on`; a slip of notation only does not count) makes it "corrected"; a
-counterexample "refuted", a theorem cited outside its hypotheses "misapplied"; a confirmation
-that needs a condition the paper does not state "reproduced under an added condition"; a
-figure whose unstated grid or criterion decides it "not reproducible as stated". A check
-decides between the status the legend gives its item and ``not reproducible``; the test suite
-asserts that it decides the claimed one and that the claimed one is the legend's.
+:func:`lib.paper.outcomes.legend_status` (a confirmed errata row on a row's equations,
+:func:`errata_on`, not a reading or a slip of notation, makes it "corrected"). A check decides
+between the status the legend gives its item and ``not reproducible``; the test suite asserts
+that it decides the claimed one and that the claimed one is the legend's.
 """
 
 from __future__ import annotations
@@ -40,7 +37,7 @@ from ..params import Body, Gains
 from ..rotation.attractor import rotation_attractor
 from ..rotation.fig5 import fig5_map
 from ..rotation.equations import derive_rotation_equation
-from ..simulate import OPEN_LOOP_HORIZON, open_loop_comparison
+from ..simulate import OPEN_LOOP_HORIZON
 from ..symbolic import derive_body_frame, rank_determinants
 from ..tracking.runs import steady_summary
 from ..trajectories import circle, eight, eight_heading_fourier
@@ -75,13 +72,11 @@ def errata_on(item: Item) -> list[str]:
 
 def _corrected_by(key: str, merit: float, merit_label: str, note: str = "", evidence: bool = True) -> Outcome:
     v = verdict(key)                 # KeyError for a key that is not an errata row
-    # a slip of notation or a reading that changes no computation links its row and corrects nothing
-    notation = next(r.notation for r in rows() if r.key == key)
+    notation = next(r.notation for r in rows() if r.key == key)     # a reading: links, corrects nothing
+    note = note or ("a reading that changes no computation" if notation else
+                    "printed form fails, corrected form holds") + " (see the errata row)"
     return Outcome(legend_status(evidence and v.corrected_holds, printed_fails=not (v.printed_holds or notation)),
-                   merit, merit_label, note or ("a reading that changes no computation (see the errata row)"
-                                                if notation else
-                                                "printed form fails, corrected form holds (see the errata row)"),
-                   erratum=key)
+                   merit, merit_label, note, erratum=key)
 
 
 def _refuted_by(key: str, merit: float, merit_label: str, note: str, evidence: bool = True) -> Outcome:
@@ -91,14 +86,8 @@ def _refuted_by(key: str, merit: float, merit_label: str, note: str, evidence: b
 
 
 # ------------------------------------------------------------------ Sec. 2
-@lru_cache(maxsize=1)
-def _open_loop_deviations() -> dict[str, float]:
-    _, runs = open_loop_comparison(Body(), OPEN_LOOP_HORIZON)
-    return {k: float(np.abs(runs[k] - runs["config"]).max()) for k in ("state", "printed")}
-
-
 def _check_config_form() -> Outcome:
-    dev = _open_loop_deviations()["state"]
+    dev = studies.open_loop_deviations()["state"]
     return Outcome(legend_status(dev < 1e-7), dev, f"max |q_(5) - q_(2)-(4)| over {OPEN_LOOP_HORIZON:g} s, open loop",
                    "the body-frame form derived from (2)-(4) follows them to integration accuracy")
 
@@ -112,16 +101,8 @@ def _check_input_fields() -> Outcome:
     return Outcome(legend_status(n_bad == 0), float(n_bad), "entries of (9)-(10) differing from the derivation")
 
 
-def open_loop_gap() -> tuple[float, float]:
-    """Distance (m) of the printed drift's centre of mass from the true one, and their headings'
-    difference (rad), at the end of Chapter 1's open-loop run (the front page quotes both)."""
-    _, runs = open_loop_comparison(Body(), OPEN_LOOP_HORIZON)
-    d = runs["printed"][-1] - runs["config"][-1]
-    return float(np.hypot(d[0], d[1])), float(abs(np.angle(np.exp(1j * d[2]))))
-
-
 def _check_drift() -> Outcome:
-    return _corrected_by("eq6-v2-row", open_loop_gap()[0],
+    return _corrected_by("eq6-v2-row", studies.open_loop_gap()[0],
                          f"distance (m) of the printed form's centre of mass from the true one after "
                          f"{OPEN_LOOP_HORIZON:g} s, open loop, the same inputs")
 
@@ -216,9 +197,7 @@ def _check_thm6() -> Outcome:
 
 
 def _check_thm7() -> Outcome:
-    # decided a mis-citation, not a misapplication: the sentence that cites "theory 7" concludes STLC
-    # for (5), which has a drift: Theorem 6's hypothesis and conclusion, not Theorem 7's (global
-    # controllability without drift, never claimed). Theorem 7 itself holds as printed (Chow).
+    # "theory 7" is a mis-citation of Theorem 6 (its conclusion, STLC with drift); Chow holds as printed
     drift = float(np.linalg.norm(f(Body(), np.array([0.0, 0.0, 0.3, 1.0, 0.5, 0.2]))))
     v = verdict("thm7-drift")
     return Outcome(legend_status(drift > 0 and v.confirmed), drift,
@@ -291,13 +270,10 @@ def _check_table() -> Outcome:  # the caption's number is a slip of notation (er
 
 
 def _check_fig4() -> Outcome:
-    # "a non-zero periodic position error" decided, not waited for: the paper's law under the 4 N cap
-    # alone reaches a located attracting orbit from the paper's start (Chapter 8's side-by-side
-    # table, decided by the book's procedure), on which C stays away from the path; and the cap
-    # binds: exact tracking of the chosen eight needs more than 4 N
-    table = studies.limits_comparison(Body(), Gains())["table"]
-    row = table[(table.law == "paper") & (table.cap == FIG4_CAP) & table.angle_deg.isna()].iloc[0]
-    need = float(exact_peak_force(Body(), R0, THETA0))
+    # "a non-zero periodic error", decided: the paper's law under the cap alone reaches a located
+    # attracting orbit (Chapter 8's table) away from the path, and the cap binds on this eight
+    t = studies.limits_comparison(Body(), Gains())["table"]
+    row, need = t[(t.law == "paper") & (t.cap == FIG4_CAP) & t.angle_deg.isna()].iloc[0], exact_peak_force(Body(), R0, THETA0)
     ok = row.regime == "periodic" and row.max_error > 1e-2 and need > FIG4_CAP
     return Outcome(legend_status(bool(ok)), float(row.max_error),
                    "largest distance (m) of C from the eight on the paper's law's attracting orbit with F <= 4 N "

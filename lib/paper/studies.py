@@ -9,6 +9,7 @@ Theta0 = pi / 4 rad/s.
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 import pandas as pd
@@ -21,14 +22,15 @@ from ..machinery.cache import cached
 from ..optimal.compare import limits_study
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from ..percussion.full_loop import full_loop_verdicts, grid_sample
-from ..simulate import Integration, simulate
+from ..simulate import OPEN_LOOP_HORIZON, Integration, open_loop_comparison, simulate
 from ..tracking.mismatch import mismatch_study
 from ..tracking.runs import run
 from ..trajectories import circle, eight
 
 __all__ = ["R0", "THETA0", "FIG4_CAP", "SWEEP_DEG", "CHAOS_DEG", "LYAPUNOV_DEG", "HORIZONS", "MIRROR_OFFSETS_DEG",
            "fig4_run", "angle_sweep", "chaos_row", "torus", "lyapunov_convergence", "mirror_starts",
-           "mirror_attractors", "wrong_model", "circle_run", "full_loop_sample", "limits_comparison"]
+           "mirror_attractors", "wrong_model", "circle_run", "full_loop_sample", "limits_comparison",
+           "open_loop_deviations", "open_loop_gap"]
 
 #: the paper's circle (its Table), and Chapter 3's eight, in m and rad/s
 R0, THETA0 = 2.0, math.pi / 4
@@ -240,3 +242,32 @@ def limits_comparison(body: Body, gains: Gains) -> dict:
         The study.
     """
     return cached(limits_study, body, gains, R0, THETA0)
+
+
+@lru_cache(maxsize=1)
+def open_loop_deviations() -> dict[str, float]:
+    """Chapter 1's open-loop run: the largest deviation, over the run and the state, of the
+    body-frame form (``"state"``) and of the printed drift (``"printed"``) from (2)-(4).
+
+    Returns
+    -------
+    dict
+        "state", "printed" -> max |q - q_(2)-(4)| (mixed units: a consistency check, not a finding).
+    """
+    _, runs = open_loop_comparison(Body(), OPEN_LOOP_HORIZON)
+    return {k: float(np.abs(runs[k] - runs["config"]).max()) for k in ("state", "printed")}
+
+
+def open_loop_gap() -> tuple[float, float]:
+    """Distance (m) of the printed drift's centre of mass from the true one, and their headings'
+    difference (rad), at the end of Chapter 1's open-loop run (the front page and the report
+    quote both).
+
+    Returns
+    -------
+    tuple of float
+        (distance in m, heading difference in rad modulo 2 pi).
+    """
+    _, runs = open_loop_comparison(Body(), OPEN_LOOP_HORIZON)
+    d = runs["printed"][-1] - runs["config"][-1]
+    return float(np.hypot(d[0], d[1])), float(abs(np.angle(np.exp(1j * d[2]))))
