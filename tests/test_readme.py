@@ -171,3 +171,56 @@ def test_ci_runs_the_portable_tests_after_make_test_with_the_emulation_the_readm
 
     names = re.search(r'NPY_DISABLE_CPU_FEATURES="([^"]*)"', make).group(1).split()
     assert names and set(names) <= set(__cpu_dispatch__) - set(__cpu_baseline__), (names, __cpu_dispatch__)
+
+
+_PAGE = """---
+jupytext:
+  text_representation:
+    extension: .md
+    format_name: myst
+kernelspec:
+  display_name: Python 3
+  language: python
+  name: python3
+---
+
+# Page {name}
+
+```{{code-cell}} ipython3
+print("{text}")
+```
+"""
+
+
+def test_one_page_mode_replaces_that_page_and_keeps_the_others(tmp_path):
+    """What `make chapter` runs (`tools/preexecute.py --keep-cache PAGE`), on a book of two
+    small pages: after the full run, the one-page run executes only the page named, whose new
+    code the cache then matches, and keeps the other page's entry as it was; a page that is not
+    in the book is refused before the cache is touched."""
+    from jupyter_cache import get_cache
+
+    sys.path.insert(0, str(ROOT / "tools"))
+    from preexecute import read_page
+
+    (tmp_path / "_config.yml").write_text("execute:\n  execute_notebooks: cache\n  cache: _build/.jupyter_cache\n"
+                                          "  timeout: 60\n")
+    (tmp_path / "_toc.yml").write_text("format: jb-book\nroot: a\nchapters:\n  - file: b\n")
+    for name in "ab":
+        (tmp_path / f"{name}.md").write_text(_PAGE.format(name=name, text=f"first {name}"))
+
+    def run(*args):
+        return subprocess.run([sys.executable, str(ROOT / "tools" / "preexecute.py"), "--root", str(tmp_path),
+                               "--jobs", "1", *args], capture_output=True, text=True, timeout=300)
+
+    assert run().returncode == 0
+    cache = get_cache(tmp_path / "_build" / ".jupyter_cache")
+    a_before = cache.match_cache_notebook(read_page(tmp_path / "a.md", tmp_path)).pk
+    (tmp_path / "b.md").write_text(_PAGE.format(name="b", text="second b"))
+    refused = run("--keep-cache", "c")
+    assert refused.returncode == 2 and "'c' is not a notebook page" in refused.stderr
+    one = run("--keep-cache", "b")
+    assert one.returncode == 0, one.stdout + one.stderr
+    assert "Executing 1 pages" in one.stdout and "  b: " in one.stdout and "  a: " not in one.stdout
+    assert cache.match_cache_notebook(read_page(tmp_path / "a.md", tmp_path)).pk == a_before
+    b = cache.get_cache_bundle(cache.match_cache_notebook(read_page(tmp_path / "b.md", tmp_path)).pk).nb
+    assert "second b" in "".join(o.get("text", "") for c in b.cells for o in c.get("outputs", []))
