@@ -126,8 +126,16 @@ def test_the_error_table_has_a_row_a_setting_and_says_where_a_run_diverged_or_no
     rows = _rows().assign(rms_stderr=np.nan)
     rows.loc[(rows.law == "paper") & (rows.setting == "30 deg"), "rms_stderr"] = 0.0123
     t = compare.error_table(rows)
-    assert t.loc["30 deg", "paper's law"] == "0.4 / 0.2 ± 0.01"     # the RMS's error, one digit
+    assert t.loc["30 deg", "paper's law"] == "0.4 / 0.20 ± 0.02"    # an estimate, its error rounded up
     assert t.loc["4 N", "paper's law"] == "0.4 / 0.2"                # NaN: no error shown
+    # the bound is written rounded down, the controller of the best motion found up (a motion that
+    # exists), the rest to nearest: 0.107693 -> 0.107 and 0.107761 -> 0.108, where both read 0.108
+    rows.loc[rows.law == "bound", "max_error"] = 0.107693
+    rows.loc[rows.law.isin(["optimal", "percussion"]), "max_error"] = 0.107761
+    t = compare.error_table(rows)
+    assert t.loc["4 N", "bound"].startswith("0.107 /")
+    assert t.loc["4 N", "best motion + LQR"].startswith("0.108 /")
+    assert t.loc["4 N", "law for P (Ch. 7)"].startswith("0.108 /")
     r = compare.regime_table(_rows())
     assert "bound" not in r.columns and (r == "periodic").all().all()
 
@@ -136,6 +144,9 @@ def test_the_tracker_table_reads_the_optimal_rows():
     t = compare.tracker_table(_rows())
     assert len(t) == 2 and list(t["starts reached"]) == ["3 of 7", "3 of 7"]
     assert list(t["paper's start"]) == ["yes", "yes"]
+    rows = _rows().assign(paper_start_reached=False, paper_start_settled=[True] * 8 + [False])
+    t = compare.tracker_table(rows)          # not reached: "no" when both maps agree, else undecided
+    assert list(t["paper's start"]) == ["no", "undecided"]
 
 
 def test_setting_labels():

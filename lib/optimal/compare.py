@@ -31,6 +31,7 @@ from ..limits.runs import switched_runs
 from ..limits.verdicts import limit_verdicts
 from ..machinery import checks
 from ..machinery.cache import source_stamp
+from ..machinery.kinds import estimate, exact, lower_bound, upper_bound
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from ..percussion import full_loop
 from ..percussion.full_loop import _limited_args, _rows_field, limited_field
@@ -50,7 +51,9 @@ __all__ = ["LAWS", "LawLoop", "law_loop", "law_row", "paper_rows", "side_by_side
 PAPER_HORIZON = 120
 #: the last periods of that run measured
 PAPER_MEASURED = 100
-#: periods a block of the batch means behind the standard error of that run's RMS distance
+#: the shortest block (periods) of the batch means behind the standard error of that run's RMS
+#: distance; :func:`lib.dynamics.statistics.block_statistics` lengthens it to six integrated
+#: autocorrelation times of the series where its memory asks
 RMS_BLOCK = 2
 
 #: the laws of the table, in its order
@@ -289,6 +292,8 @@ def paper_rows(body: Body, gains: Gains, ref, settings=SETTINGS, *, horizon: int
 
 #: the optimal motion's controller decided on its period map by RK4 with this many fixed steps on
 #: each input piece (two a collocation interval), from the tracker's seven starts over this many periods
+#: RK4 steps an input piece the verdict starts from (doubled by motion_verdict until the orbit
+#: holds when h is halved), and the periods a start is run
 OPTIMAL_STEPS, OPTIMAL_PERIODS = 2, 8
 
 
@@ -306,7 +311,9 @@ def _optimal_row(body: Body, motion, limits: Limits, solved: dict) -> dict:
                            beta_max=limits.angle)
     return dict(regime=v.regime, reason=v.reason, floquet=float(np.abs(v.multipliers).max()),
                 paper_start_reached=bool(v.reached[0]), starts_reached=int(v.reached.sum()),
-                starts=int(v.reached.size), **meas)
+                starts=int(v.reached.size), paper_start_settled=bool(v.settled[0]),
+                starts_settled=int(v.settled.sum()), verdict_steps=int(v.steps), orbit_shift=float(v.orbit_shift),
+                multiplier_spread=float(v.multiplier_spread), **meas)
 
 
 def side_by_side(body: Body, gains: Gains, R: float, Theta: float, motions: dict, bounds: dict, *,
@@ -414,9 +421,11 @@ def _by_setting(table: pd.DataFrame, values: str, laws) -> pd.DataFrame:
 
 def error_table(table: pd.DataFrame) -> pd.DataFrame:
     """:func:`side_by_side`'s table as the page shows it: one row a setting, one column a law, each
-    cell "largest / RMS" distance (m, three significant digits; the RMS "± its standard error" where
-    the row has one, ``rms_stderr``), "diverges" where the run blew up and "-" where there is no
-    row (no bound without a cap).
+    cell "largest / RMS" distance (m, three significant digits, each written as its kind says:
+    the bound's rounded down, the controller of the best motion found's rounded up, being values
+    of a motion that exists; the RMS "± its standard error", to two decimals, where the row has
+    one, ``rms_stderr``), "diverges" where the run blew up and "-" where there is no row (no bound
+    without a cap).
 
     Parameters
     ----------
@@ -432,7 +441,9 @@ def error_table(table: pd.DataFrame) -> pd.DataFrame:
         if not np.isfinite(r.max_error):
             return "diverges"
         se = r.get("rms_stderr", np.nan)
-        return f"{r.max_error:.3g} / {r.rms_error:.3g}" + (f" ± {se:.1g}" if np.isfinite(se) else "")
+        kind = {"bound": lower_bound, "optimal": upper_bound}.get(r.law, exact)
+        rms = estimate(r.rms_error, se, ".2f") if np.isfinite(se) else kind(r.rms_error, ".3g")
+        return f"{kind(r.max_error, '.3g').text()} / {rms.text()}"
 
     return _by_setting(table.assign(v=table.apply(cell, axis=1)), "v", LAW_NAMES).fillna("-")
 
@@ -455,7 +466,9 @@ def regime_table(table: pd.DataFrame) -> pd.DataFrame:
 
 def tracker_table(table: pd.DataFrame) -> pd.DataFrame:
     """The best motions' controllers from :func:`side_by_side`'s table: setting, regime, largest
-    |multiplier|, starts reached, whether the paper's start is, largest and RMS distance (m).
+    |multiplier|, starts reached (on both maps of the verdict, step h and h/2), whether the paper's
+    start is ("undecided" where the two maps disagree), largest and RMS distance (m, rounded up:
+    values of a motion that exists).
 
     Parameters
     ----------
@@ -472,5 +485,8 @@ def tracker_table(table: pd.DataFrame) -> pd.DataFrame:
         "setting": opt.setting, "regime": opt.regime,
         "largest |multiplier|": opt.floquet.map("{:.3f}".format),
         "starts reached": [f"{int(r)} of {int(n)}" for r, n in zip(opt.starts_reached, opt.starts)],
-        "paper's start": opt.paper_start_reached.map({True: "yes", False: "no"}),
-        "largest (m)": opt.max_error.map("{:.3g}".format), "RMS (m)": opt.rms_error.map("{:.3g}".format)})
+        "paper's start": ["yes" if r else ("no" if s else "undecided")
+                          for r, s in zip(opt.paper_start_reached, opt.get("paper_start_settled",
+                                                                           pd.Series(True, index=opt.index)))],
+        "largest (m)": [upper_bound(v, ".3g").text() for v in opt.max_error],
+        "RMS (m)": [upper_bound(v, ".3g").text() for v in opt.rms_error]})
