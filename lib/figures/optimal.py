@@ -126,18 +126,25 @@ def plot_force_maps(maps, ax=None):
 
 def plot_basin(frame, title: str = "", ax=None):
     """Which starts reach the controller's orbit (:func:`lib.optimal.verdict.basin`): the
-    paper's start moved in heading (rad) and in x (m); filled, reached; open, not.
+    paper's start moved in heading (rad) and in x (m); filled, reached on both maps of the
+    verdict (step h and h/2); open, not reached on either; grey diamonds, reached on one map only
+    (undecided), where ``frame`` has the column ``settled``.
 
     Returns
     -------
     matplotlib.figure.Figure
     """
     fig, ax = (plt.subplots(figsize=(6.0, 3.6)) if ax is None else (ax.figure, ax))
+    settled = frame["settled"] if "settled" in frame else np.ones(len(frame), bool)
     hit = frame[frame.reached]
-    miss = frame[~frame.reached]
+    miss = frame[~frame.reached & settled]
+    split = frame[~frame.reached & ~settled]
     ax.scatter(hit.heading_offset, hit.x_offset, s=40, c="C2", label="reaches the orbit")
     ax.scatter(miss.heading_offset, miss.x_offset, s=40, facecolors="none", edgecolors="C3",
                label="does not")
+    if len(split):
+        ax.scatter(split.heading_offset, split.x_offset, s=30, marker="D", c="0.6",
+                   label="on one map only")
     ax.scatter([0.0], [0.0], marker="x", c="k", s=60, label="the paper's start")
     ax.set_xlabel("heading offset from the paper's start (rad)")
     ax.set_ylabel("x offset (m)")
