@@ -1,8 +1,8 @@
 """``make pdf``'s route, run as CI runs it: the single-page HTML build read from the execution
 cache that the book's build filled, printed by headless Chromium (``tools/pdf.py``). The PDF
 holds every page of the table of contents in order, the front page's findings with their glued
-numbers, typeset math (no TeX source left), and every figure of the book as an image, the
-interactive ones as static PNGs.
+numbers, typeset math (no TeX source left), every figure of the book as an image, the
+interactive ones as static PNGs, and nothing cut off at the right edge.
 
 Needs Debian's ``chromium`` and poppler's ``pdftotext`` and ``pdfimages`` (``.ci/run`` installs
 both); without them the tests are skipped with a message saying so.
@@ -164,3 +164,10 @@ def test_every_figure_is_printed_as_an_image_the_interactive_ones_as_static_png(
     assert images + interactive >= sum(labels.values())
     assert len(book_pdf["images"]) >= images + interactive, (len(book_pdf["images"]), images, interactive)
     assert not book_pdf["held"]["broken"] and not book_pdf["held"]["requests"]
+
+
+def test_nothing_is_cut_off_at_the_right_edge(book_pdf):
+    """What the screen scrolls sideways (a wide table, a long code line, a wide formula) was made
+    to fit the printed column: no element of the printed page still clips its content sideways."""
+    fitted = book_pdf["held"]["fitted"]
+    assert fitted["nClipped"] == 0, fitted["clipped"]

@@ -90,6 +90,44 @@ COUNT_FIGURES = """() => {
           untypeset: nodes.filter(n => !n.querySelector('mjx-container')).map(n => n.textContent.slice(0, 80))};
 }"""
 
+#: what the screen scrolls sideways, made to fit the printed column, where paper cannot scroll: a
+#: table wider than its box laid out at the column's width (smaller type, words and code names
+#: broken at need), a code line wrapped, a display formula scaled down to the column; then every element that still
+#: clips its content sideways is listed (none should be)
+FIT_WIDE = """() => {
+  const main = document.querySelector('main') || document.body;
+  const wide = (el, box) => el.scrollWidth > (box || el).clientWidth + 1;
+  const fitted = {tables: 0, code: 0, math: 0};
+  for (const t of main.querySelectorAll('table')) {
+    const box = t.closest('.pst-scrollable-table-container, .table-wrapper') || t.parentElement;
+    if (!wide(t, box) && !wide(box)) continue;
+    Object.assign(t.style, {width: '100%', tableLayout: 'fixed', fontSize: '85%'});
+    t.querySelectorAll('td, th').forEach(c => Object.assign(c.style, {overflowWrap: 'anywhere', wordBreak: 'break-word'}));
+    t.querySelectorAll('code, span.pre').forEach(c => Object.assign(c.style, {whiteSpace: 'normal', wordBreak: 'break-all'}));
+    fitted.tables++;
+  }
+  for (const p of main.querySelectorAll('pre')) {
+    if (wide(p)) { Object.assign(p.style, {whiteSpace: 'pre-wrap', overflowWrap: 'anywhere'}); fitted.code++; }
+  }
+  for (const m of main.querySelectorAll('mjx-container[display="true"], td mjx-container, th mjx-container')) {
+    const box = m.closest('td, th, div.math') || m.parentElement;
+    if (box.clientWidth > 0 && m.scrollWidth > box.clientWidth + 1) {
+      m.style.fontSize = Math.floor(100 * box.clientWidth / m.scrollWidth) + '%';
+      fitted.math++;
+    }
+  }
+  const clipped = [];
+  for (const el of main.querySelectorAll('*')) {
+    if (el.closest('span.math, mjx-container')) continue;   // MathJax's hidden assistive MathML widens these
+    const css = getComputedStyle(el);
+    if (['auto', 'scroll', 'hidden'].includes(css.overflowX) && css.display !== 'inline' && el.clientWidth > 0
+        && wide(el))
+      clipped.push(`${el.tagName.toLowerCase()}.${el.className} by ${el.scrollWidth - el.clientWidth} px: ` +
+                   (el.innerText || '').replace(/\s+/g, ' ').slice(0, 60));
+  }
+  return {...fitted, clipped: clipped.slice(0, 50), nClipped: clipped.length};
+}"""
+
 #: for print: the theme's navigation hidden, the content the full width; each page of the book
 #: (a ``document-`` anchor before its section) starts a printed page; figures, formulas and table
 #: rows are not split; shadows, which Chromium prints as raster images, are dropped; an
@@ -212,7 +250,8 @@ def print_pdf(html_dir: Path, out: Path, page_name: str = "intro") -> dict:
         interactive = page.evaluate(STATIC_PLOTLY)
         page.add_style_tag(content=PRINT_CSS)
         page.emulate_media(media="print")
-        held = page.evaluate(COUNT_FIGURES)
+        fitted = page.evaluate(FIT_WIDE)
+        held = {**page.evaluate(COUNT_FIGURES), "fitted": fitted}
         page.pdf(path=str(out), format="A4", print_background=True, margin=MARGIN, scale=SCALE,
                  display_header_footer=True, header_template="<span></span>", footer_template=FOOTER)
         browser.close()
