@@ -43,13 +43,13 @@ __all__ = ["ensemble_ratio", "limit_ensemble", "rotation_ensemble", "calibration
 
 #: the angle limits (deg) studied, without a cap, on Chapter 4's eight (R = 2 m, Theta = pi/4 rad/s)
 LIMIT_DEG = (30, 45)
-#: chaotic points of Fig. 5 studied: (i, j) on the n x n grid of :data:`FIG5_GRID`, R_i, Theta_j
+#: chaotic points of Fig. 5 studied, (i, j) on the n x n grid of ``FIG5_GRID``, R_i, Theta_j
 FIG5_POINTS = ((2, 26), (58, 50), (74, 58), (10, 74), (50, 82), (82, 82), (18, 90), (66, 98), (2, 98))
 #: independent starts per angle limit and per Fig. 5 point
 LIMIT_STARTS, ROTATION_STARTS = 32, 64
 #: periods run before measuring (the limit verdicts' transient), the periods measured, the RMS's last periods
 BURN_IN, LIMIT_PERIODS, RMS_PERIODS = 60, 120, 100
-#: the limit runs' starts: the paper's state moved by this much (m, rad, m/s, rad/s) in each coordinate
+#: the limit runs' starts are the paper's state moved by this much (m, rad, m/s, rad/s) in each coordinate
 START_SPREAD = 1e-6
 #: the band the ratio of spread to error must lie in, and the confidence level of its interval
 RATIO_BAND, LEVEL = (0.8, 1.25), 0.95

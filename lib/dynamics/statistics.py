@@ -26,12 +26,12 @@ from ..angles import wrap_angle
 __all__ = ["block_statistics", "batch_means", "drift_statistics", "integrated_time", "block_length",
            "section_returns", "BLOCK_TAUS", "SOKAL_WINDOW"]
 
-#: a block is at least this many integrated autocorrelation times long: the batch-means
+#: a block is at least this many integrated autocorrelation times long, so that the batch-means
 #: variance of an AR(1) series is then biased low by less than 1 / BLOCK_TAUS (its standard
 #: error by less than half that), see :func:`block_length`
 BLOCK_TAUS = 6
 
-#: Sokal's automatic window: the autocorrelations are summed up to the first lag M >= c tau_int(M)
+#: Sokal's automatic window c, the autocorrelations summed up to the first lag M >= c tau_int(M)
 SOKAL_WINDOW = 5.0
 
 

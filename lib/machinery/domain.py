@@ -36,7 +36,7 @@ MAX_STEPS = 2 ** 14
 #: the most points a map over an n x n grid may hold (Fig. 5's 100 x 100 takes about 20 s of CPU, 2 ms a
 #: point: 250 000 points, n = 500, take about 10 minutes on one core)
 MAX_GRID_POINTS = 250_000
-#: the most samples of a run's default output grid (each sample holds 18 numbers: about 300 MB)
+#: the most samples of a run's default output grid (each sample holds 18 numbers, about 300 MB)
 MAX_SAMPLES = 2_000_000
 #: the most reference periods the heading's damping time I_C / c_phi may last in a verdict
 #: (their transients run 16 to 48 periods, so a start is forgotten before the orbit search begins)

@@ -17,7 +17,7 @@ The code that computes a number says its kind by wrapping it (:func:`lower_bound
 with the unrounded value and the kind beside it, so that a test of the built book can check every
 glued bound's rounding against its value, and the words around it against its kind
 (``tests/test_number_kinds.py``). Rounding toward safety is done in decimal arithmetic
-(:mod:`decimal`), not by nudging a float.
+(``decimal``), not by nudging a float.
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ class Kind(str, Enum):
 
     @property
     def rounding(self) -> str:
-        """How the kind rounds: "down", "up" or "nearest"."""
+        """The kind's rounding, "down", "up" or "nearest"."""
         return {Kind.LOWER: "down", Kind.UPPER: "up", Kind.FOUND: "up"}.get(self, "nearest")
 
 

@@ -429,7 +429,7 @@ def _check_loop(body, motion, limits, lqr, Q=None, R_weight=None) -> None:
 
 
 def _check_span(motion, t_end: float, default_samples: bool) -> None:
-    """Refuse, before any work, a ``t_end`` (s) over more than :data:`lib.machinery.checks.MAX_RUN_STEPS`
+    """Refuse, before any work, a ``t_end`` (s) over more than :data:`lib.machinery.domain.MAX_RUN_STEPS`
     input pieces (each a solve of DOP853), or with more default output times than :data:`MAX_SAMPLES`."""
     breaks = len(getattr(motion, "t", [0.0]))
     pieces = (math.floor(t_end / float(motion.period)) + 1) * breaks
@@ -477,7 +477,7 @@ def track_motion(body: Body, motion, t_end: float, *, limits: Limits | None = No
         applied (clipped) inputs; tau = (F cos(phi + beta), F sin(phi + beta), F a sin beta)
         (N, N, N m), the generalised force *applied* (not a computed-torque demand). A blow-up
         raises SimulationError naming the time. A ``t_end`` over more than
-        :data:`lib.machinery.checks.MAX_RUN_STEPS` input pieces (each at least one step of DOP853),
+        :data:`lib.machinery.domain.MAX_RUN_STEPS` input pieces (each at least one step of DOP853),
         or whose default output times exceed :data:`MAX_SAMPLES`, is refused before any work.
     """
     _check_loop(body, motion, limits, lqr, Q, R_weight)

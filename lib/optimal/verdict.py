@@ -10,7 +10,7 @@ beside those kinks. Three consequences shape this module:
   step is halved, ``tests/test_optimal_convergence.py``), and no grid of steps can follow kinks
   that move with the state. Each verdict is therefore taken on two maps, h and h / 2, and decided
   only when the orbit moves by at most :data:`ORBIT_SHIFT_TOL` between them; the steps are doubled
-  from the ones asked for until it does (at most :data:`lib.machinery.checks.MAX_STEPS` a period).
+  from the ones asked for until it does (at most :data:`lib.machinery.domain.MAX_STEPS` a period).
 - The field is continuous, so where the orbit crosses a kink transversally the saltation matrix is
   the identity and the period map is differentiable; but a kink within a difference step of the
   orbit bends the difference quotient, and one through the orbit point makes the map not
@@ -45,11 +45,11 @@ from .tracker import (DEFAULT_STARTS, NEWTON_ITER, NEWTON_STALL, NEWTON_TOL, REA
 
 __all__ = ["MotionVerdict", "motion_verdict", "basin", "ORBIT_SHIFT_TOL", "MULTIPLIER_TOL", "FINE_RTOL"]
 
-#: the most the orbit may move (max-norm, state units) when the step is halved: a tenth of the
+#: the most the orbit may move (max-norm, state units) when the step is halved, a tenth of the
 #: reach tolerance :data:`lib.optimal.tracker.REACH_TOL`, so that a start's distance to it is
 #: decided by the dynamics, not by the step
 ORBIT_SHIFT_TOL = 0.1 * REACH_TOL
-#: the most |mu_1| may change between central differences of step d and d / 2: the verdict reads
+#: the most |mu_1| may change between central differences of step d and d / 2, as the verdict reads
 #: |mu_1| < 1, and the reach test |mu_1| ** (periods / 2) against a factor 3
 MULTIPLIER_TOL = 0.05
 #: the adaptive map's second tolerance (``steps`` = 0): DOP853 at rtol = atol = RTOL / 100
@@ -165,7 +165,7 @@ def _radius(mult) -> float:
 
 def _ladder(steps: int, pieces: int) -> list:
     """The maps tried, coarse to fine: (steps, rtol) doubling from ``steps`` while a period's
-    steps stay within :data:`lib.machinery.checks.MAX_STEPS` (at least one halving), or the two
+    steps stay within :data:`lib.machinery.domain.MAX_STEPS` (at least one halving), or the two
     tolerances of DOP853 for ``steps`` = 0."""
     if steps == 0:
         return [(0, RTOL), (0, FINE_RTOL)]

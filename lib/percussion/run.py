@@ -11,7 +11,7 @@ from ..machinery import checks
 from ..allocation import Limits
 from ..integrators.smooth import Integration, SimulationError, integrate
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
-from ..simulate import DEFAULT_RATE, SimulationResult, run_budget
+from ..simulate import SimulationResult, default_times, run_budget
 from ..trajectories import Reference, position_kinematics
 from .law import ANTI_WINDUP_TIME, DEFAULT_POLE, closed_loop_rates, error_polynomial
 from .point import point_accel, point_state
@@ -119,11 +119,7 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
     t_aw = anti_windup_time if anti_windup else None
     coeffs = error_polynomial(body, gains, pole)
     _check_budget(body, ref, coeffs, t_end, integration)
-    if t_eval is None:
-        t_eval = np.linspace(0.0, t_end, int(round(t_end * DEFAULT_RATE)) + 1)
-    t_eval = checks.array("t_eval", t_eval, ndim=1, nonempty=True)
-    if t_eval[0] < 0 or t_eval[-1] > t_end or np.any(np.diff(t_eval) <= 0):
-        raise ValueError("t_eval must be a non-empty increasing 1-D array within [0, t_end]")
+    t_eval = default_times(t_end, t_eval)      # the one check, refused before the array is built
     kin = position_kinematics(ref)
 
     def rhs(t, y):
