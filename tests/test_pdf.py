@@ -27,7 +27,7 @@ from pdf import CHROMIUM, OUT, SINGLE, root_page  # noqa: E402  (tools/ is not a
 from preexecute import toc_pages  # noqa: E402
 
 GLUE_ROLE = re.compile(r"\{glue(?::text)?\}`([^`]+)`")
-#: the book printed on 262 A4 pages (2026-11-28), every page of the table of contents starting
+#: the book printed on 269 A4 pages (2026-11-28), every page of the table of contents starting
 #: a printed page; fewer than this means whole parts of it are missing
 MIN_PAGES = 150
 

@@ -131,12 +131,13 @@ FIT_WIDE = """() => {
 #: for print: the theme's navigation hidden, the content the full width; each page of the book
 #: (a ``document-`` anchor before its section) starts a printed page; figures, formulas and table
 #: rows are not split; shadows, which Chromium prints as raster images, are dropped; an
-#: animation prints its first frame without its controls; folded blocks (hidden inputs) stay folded
+#: animation prints its first frame without its controls; a cell's folded source (hide-input),
+#: which paper cannot unfold, is left out with its "Show code cell source" toggle
 PRINT_CSS = """
 @media print {
   .bd-header, .bd-sidebar-primary, .bd-sidebar-secondary, .bd-footer, .bd-footer-content,
   .header-article, .prev-next-area, .headerlink, .toggle-button, #pst-back-to-top,
-  .anim-controls { display: none !important; }
+  .anim-controls, details.hide.above-input { display: none !important; }
   .bd-main .bd-content .bd-article-container, .bd-page-width { max-width: 100% !important; }
   span[id^="document-"] + section { break-before: page; }
   figure, img, .plotly-static, tr, mjx-container[display="true"] { break-inside: avoid; }
