@@ -34,6 +34,7 @@ from ..integrators.batch import RK4, fixed_steps, integrate
 from ..integrators.smooth import SimulationError
 from ..machinery import checks
 from ..machinery.cache import cached
+from ..machinery.kinds import lower_bound, upper_bound
 from ..model import config_accel
 from ..params import Body, Gains
 from ..tracking.mismatch import PARAMETERS, model_of
@@ -48,7 +49,8 @@ from .tracker import (DEFAULT_STARTS, RTOL, PeriodicLQR, _edges, _inside, _insid
 from .verdict import NEWTON_TOL, ORBIT_SHIFT_TOL, MotionVerdict, _decide, _ladder, _orbit, motion_verdict
 
 __all__ = ["MARGIN", "MARGIN_SETTINGS", "WRONG_DELTA", "PUSH", "SECOND_EIGHT", "plant_lqr", "pushed_verdict",
-           "tracked_case", "margin_cases", "wrong_model_cases", "eight_comparison", "issue_study"]
+           "tracked_case", "margin_cases", "wrong_model_cases", "eight_comparison", "issue_study",
+           "margin_table", "wrong_model_table", "eights_table", "PARAMETER_NAMES"]
 
 #: the margin: the plan's cap as a fraction of the cap in the loop
 MARGIN = 0.9
@@ -409,3 +411,85 @@ def issue_study(body: Body, gains: Gains, R: float, Theta: float, *, fraction: f
     margin = margin_cases(body, motions, fraction=fraction)
     return dict(margin=margin["table"], wrong=wrong_model_cases(body, margin["plans"]),
                 second=eight_comparison(body, gains, *SECOND_EIGHT))
+
+
+#: how the page names the plant's parameters and the push
+PARAMETER_NAMES = {"m": "$m$", "I": "$I_C$", "c": "$c$", "c_phi": r"$c_\varphi$", "a": "$a$", "push": "push"}
+
+
+def _tracked_cells(frame: pd.DataFrame) -> dict:
+    """The tracker's columns as the page writes them: regime, |mu_1| (rounded up), starts reached,
+    largest and RMS distance (m, rounded up: values of a motion that exists)."""
+    return {"regime": list(frame.regime),
+            "largest $|\\mu_1|$": [upper_bound(v, ".3f").text() for v in frame.floquet],
+            "starts reached": [f"{int(r)} of {int(n)}" for r, n in zip(frame.starts_reached, frame.starts)],
+            "largest (m)": [upper_bound(v, ".3f").text() if np.isfinite(v) else "-" for v in frame.max_error],
+            "RMS (m)": [upper_bound(v, ".4f").text() if np.isfinite(v) else "-" for v in frame.rms_error]}
+
+
+def margin_table(table: pd.DataFrame) -> pd.DataFrame:
+    """:func:`margin_cases`' table as the page shows it: setting, the plan's cap (N), then the
+    tracker's regime, |mu_1|, starts reached and errors under the full limits.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        :func:`margin_cases`' ``table``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row a (setting, margin), the cells formatted.
+    """
+    return pd.DataFrame({"setting": list(table.setting), "plan's cap (N)": [f"{c:g}" for c in table.plan_cap],
+                         **_tracked_cells(table)})
+
+
+def wrong_model_table(frame: pd.DataFrame, setting: str, margin: bool) -> pd.DataFrame:
+    """:func:`wrong_model_cases`' rows at one setting and margin as the page shows them:
+    the plant's parameter, its change, and the tracker's cells.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        :func:`wrong_model_cases`' frame.
+    setting : str
+        The setting's label (:func:`lib.optimal.study.setting_label`).
+    margin : bool
+        With the margin or without.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row a case.
+    """
+    rows = frame[(frame.setting == setting) & (frame.margin == margin)]
+    if rows.empty:
+        raise ValueError(f"setting = {setting!r} with margin = {margin} has no rows")
+    change = ["0.2 N along x" if p == "push" else f"{d:+.0%}".replace("%", " %")
+              for p, d in zip(rows.parameter, rows.delta)]
+    return pd.DataFrame({"plant's": [PARAMETER_NAMES[p] for p in rows.parameter], "change": change,
+                         **_tracked_cells(rows)})
+
+
+def eights_table(rows: list) -> pd.DataFrame:
+    """The headline comparison on each eight: the certified bound on the largest distance
+    (rounded down), the paper's law's and the tracker of the best motion found's (rounded up),
+    and the paper's law over the bound (rounded up: the bound is a lower bound).
+
+    Parameters
+    ----------
+    rows : list of dict
+        Each with name, R (m), Theta (rad/s), bound, paper, best (largest distances, m).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row an eight.
+    """
+    return pd.DataFrame({"eight": [r["name"] for r in rows],
+                         "$R$ (m), $\\Theta$ (rad/s)": [f"{r['R']:g}, {r['Theta']:.3g}" for r in rows],
+                         "bound (m)": [lower_bound(r["bound"], ".4f").text() for r in rows],
+                         "paper's law (m)": [upper_bound(r["paper"], ".3f").text() for r in rows],
+                         "best found + LQR (m)": [upper_bound(r["best"], ".4f").text() for r in rows],
+                         "paper / bound": [upper_bound(r["paper"] / r["bound"], ".2f").text() for r in rows]})
