@@ -384,7 +384,71 @@ def test_optimal_tracker_row_fails_with_each_clause(monkeypatch, kw, status):
     assert _status(monkeypatch, "optimal-tracker", cached=_cached_study(_ch8_study(**kw))) == status
 
 
+# ------------------------------------------------------------------ issue 51: margin, wrong plant, second eight
+_MARGIN_SETTINGS = ("4 N", "30 deg + 4 N")
+
+
+def _issue51(*, regimes=None, mu_on=None, cost=None, wrong_regime=None, worst=0.33, need=9.46, ratio=3.0,
+             trk_regime="periodic", trk_rms=0.3356):
+    """Chapter 8's issue-51 study with every clause met, or broken where an argument says so."""
+    margin = pd.DataFrame([dict(setting=s, margin=m, regime=(regimes or {}).get((s, m), "periodic"),
+                                floquet=(mu_on or {}).get(s, 0.001) if m else 0.03,
+                                rms_error=0.1 + ((cost or {}).get(s, 0.07) if m else 0.0),
+                                starts_reached=3, starts=7, plan_cap=3.6 if m else 4.0)
+                           for s in _MARGIN_SETTINGS for m in (False, True)])
+    wrong = pd.DataFrame([dict(setting=s, margin=m, parameter=p, regime="periodic", rms_error=0.2)
+                          for s in _MARGIN_SETTINGS for m in (False, True) for p in ("m", "c")])
+    wrong.loc[0, "rms_error"] = worst
+    for i, r in (wrong_regime or {}).items():
+        wrong.loc[i, "regime"] = r
+    b = SimpleNamespace(max_error=0.462, rms_error=0.3346, rms_error_achieved=0.3347)
+    second = dict(R=1.5, Theta=1.2, need=need, bound=b, paper=dict(max_error=ratio * 0.462),
+                  tracked=dict(regime=trk_regime, rms_error=trk_rms, max_error=0.476))
+    return dict(margin=margin, wrong=wrong, second=second)
+
+
+def _cached_issue51(st):
+    def fake(fn, *args):
+        assert fn is ext.margins.issue_study and _same(args, (ext.Body(), ext.Gains(), ext.R0, ext.THETA0)), args
+        return st
+    return fake
+
+
+@pytest.mark.parametrize("kw, status", [
+    ({}, "extended"),
+    ({"regimes": {("30 deg + 4 N", True): "undecided"}}, "not reproducible"),   # one loop not periodic
+    ({"mu_on": {"4 N": 0.05}}, "not reproducible"),                          # the margin contracts slower
+    ({"mu_on": {"30 deg + 4 N": 0.05}}, "not reproducible"),                 # ... at the other setting
+    ({"cost": {"30 deg + 4 N": -0.01}}, "not reproducible"),                 # the margin costs nothing
+])
+def test_margin_row_fails_with_each_clause(monkeypatch, kw, status):
+    assert _status(monkeypatch, "tracker-margin", cached=_cached_issue51(_issue51(**kw))) == status
+
+
+@pytest.mark.parametrize("kw, status", [
+    ({}, "extended"),
+    ({"wrong_regime": {5: "undecided"}}, "not reproducible"),                # one plant not periodic
+    ({"worst": 0.6}, "not reproducible"),                                   # an error over half a metre
+    ({"worst": np.nan}, "not reproducible"),                                # no orbit to measure
+])
+def test_tracker_wrong_model_row_fails_with_each_clause(monkeypatch, kw, status):
+    assert _status(monkeypatch, "tracker-wrong-model", cached=_cached_issue51(_issue51(**kw))) == status
+
+
+@pytest.mark.parametrize("kw, status", [
+    ({}, "extended"),
+    ({"need": 3.9}, "not reproducible"),                                    # the cap does not bind
+    ({"ratio": 0.9}, "not reproducible"),                                   # the law below the bound
+    ({"trk_regime": "undecided"}, "not reproducible"),                      # the tracker not periodic
+    ({"trk_rms": 0.3340}, "not reproducible"),                              # the tracker below the bound
+    ({"trk_rms": 0.3400}, "not reproducible"),                              # over 1 % above the bracket
+])
+def test_second_eight_row_fails_with_each_clause(monkeypatch, kw, status):
+    assert _status(monkeypatch, "second-eight", cached=_cached_issue51(_issue51(**kw))) == status
+
+
 def test_every_extension_row_has_a_falsifying_test():
     tested = {"limit-lyapunov", "limit-mirror", "wrong-model", "slow-eights", "window", "weight-limit",
-              "percussion-circle", "percussion-map", "cap-bound", "angle-optimum", "optimal-tracker", "fig5-map"}
+              "percussion-circle", "percussion-map", "cap-bound", "angle-optimum", "optimal-tracker", "fig5-map",
+              "tracker-margin", "tracker-wrong-model", "second-eight"}
     assert set(ITEMS) == tested

@@ -22,7 +22,8 @@ from ..params import Body, Gains
 from ..percussion import percussion_fig5_map
 from ..rotation.circle_global import bistable_window
 from ..rotation.fig5 import fig5_map
-from ..machinery.kinds import Number, best_found
+from ..machinery.kinds import Number, best_found, upper_bound
+from ..optimal.margins import SECOND_EIGHT
 from ..simulate import OPEN_LOOP_HORIZON
 from ..trajectories import eight
 from . import studies
@@ -38,7 +39,7 @@ FINDINGS = {
     "eq6": "corrected", "thm6": "refuted", "thm7": "reproduced", "stlc": "refuted", "gas": "refuted",
     "window": "extended", "fig3": "reproduced", "limit-mirror": "extended", "chaos": "reproduced",
     "quasi": "reproduced under an added condition", "fig5": "not reproducible as stated", "fig5-map": "extended",
-    "weight-limit": "extended", "percussion-map": "extended", "cap-bound": "extended",
+    "weight-limit": "extended", "percussion-map": "extended", "cap-bound": "extended", "second-eight": "extended",
 }
 
 #: for each page, the numbers its findings box glues: name -> (unit, reading). The unit is written
@@ -59,6 +60,8 @@ LABELS = {
         "fd_p_held": ("points", "law for P"), "fd_p_grid": ("points", "held"),
         "fd_paper_held": ("points", "paper's law"), "fd_bound": ("m", "lower bound"),
         "fd_paper_cap": ("m", "paper's law"), "fd_opt_cap": ("m", "controller tracking the best motion"),
+        "fd_e2_R": ("m", "second eight"), "fd_e2_Theta": ("rad/s", "second eight"),
+        "fd_e2_ratio": ("times", "second eight"), "fd_e1_ratio": ("times", "paper's law"),
     },
     "chapters/01_model": {
         "n_wrong_rows": ("row", "drift"), "wrong_row": ("row", "wrong sign"),
@@ -94,10 +97,13 @@ LABELS = {
     },
     "chapters/08_optimal": {
         "b4_max": ("m", "lower bound"), "b4_max_ach": ("m", "motion"), "p4_max": ("m", "paper's law"),
-        "p4_ratio": ("times", "least possible"), "m30c_rms": ("m", "RMS"), "paper30c_rms": ("m", "RMS"),
+        "p4_ratio": ("times", "least possible"), "bf30c_rms": ("m", "RMS"), "paper30c_rms": ("m", "RMS"),
         "paper30c_ratio": ("times", "as much"), "opt_periodic": ("settings", "periodic orbit"),
         "opt_n": ("settings", "periodic orbit"), "opt_paper_reached": ("settings", "paper's start"),
+        "opt_paper_undecided": ("settings", "undecided"),
         "map_ratio_median": ("times", "median"), "map_FP_max": ("N", "peak force"),
+        "mg_cap_cost_rms": ("m", "RMS"), "mg_e2_ratio": ("times", "least possible"),
+        "mg_e1_ratio": ("times", "least possible"),
     },
 }
 
@@ -140,7 +146,8 @@ def front_page() -> dict[str, float | Number]:
     free, capped = _angle_sweep(None), _angle_sweep(PAPER_CAP)
     lo, hi = cached(bistable_window, Body(), THETA0)                       # Chapter 5's call
     paper, p_law = fig5_readings(cached(fig5_map, Body())), fig5_readings(cached(percussion_fig5_map, Body()))
-    table = studies.limits_comparison(Body(), Gains())["table"]                # Chapter 8's call
+    lim = studies.limits_comparison(Body(), Gains())                            # Chapter 8's call
+    table = lim["table"]
     cap_only = table[(table.cap == PAPER_CAP) & table.angle_deg.isna()].set_index("law")
     out = {
         "fd_eq6_t": OPEN_LOOP_HORIZON, "fd_eq6_pos": pos, "fd_eq6_heading": heading, "fd_fig3": f["fig3"].merit,
@@ -154,6 +161,8 @@ def front_page() -> dict[str, float | Number]:
         "fd_p_held": p_law["held"], "fd_p_grid": p_law["grid"], "fd_bound": f["cap-bound"].number(".4f"),
         "fd_paper_cap": float(cap_only.max_error["paper"]),
         "fd_opt_cap": best_found(float(cap_only.max_error["optimal"]), ".4f"),
+        "fd_e2_R": SECOND_EIGHT[0], "fd_e2_Theta": SECOND_EIGHT[1], "fd_e2_ratio": f["second-eight"].number(".2f"),
+        "fd_e1_ratio": upper_bound(float(cap_only.max_error["paper"]) / lim["bound"].max_error, ".2f"),
     }
     assert set(out) == set(LABELS["intro"]), set(out) ^ set(LABELS["intro"])
     return out
