@@ -94,7 +94,7 @@ COUNT_FIGURES = """() => {
 #: table wider than its box laid out at the column's width (smaller type, words and code names
 #: broken at need), a code line wrapped, a display formula scaled down to the column; then every element that still
 #: clips its content sideways is listed (none should be)
-FIT_WIDE = """() => {
+FIT_WIDE = r"""() => {
   const main = document.querySelector('main') || document.body;
   const wide = (el, box) => el.scrollWidth > (box || el).clientWidth + 1;
   const fitted = {tables: 0, code: 0, math: 0};
