@@ -128,6 +128,6 @@ def test_starts_moved_by_a_micrometre_are_far_apart_after_the_burn_in():
     # chaos separates them: the smallest distance between two starts' states after the
     # burn-in is many orders above the 1e-6 they started apart
     fr = cal.limit_ensemble(Body(), Gains(), 30.0, 3)
-    assert fr.attrs["separation"] > 1e3 * cal.START_SPREAD
+    assert fr.attrs["separation"] > 1e3 * cal.START_SPREAD   # reason: decorrelated by chaos, not a bound
     assert (fr.lyapunov > 3 * fr.lyapunov_stderr).all()
     assert (fr.rms_stderr > 0).all() and (fr.drift_stderr > 0).all()
