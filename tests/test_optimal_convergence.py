@@ -50,7 +50,7 @@ def test_the_planned_force_sits_at_its_cap_for_most_of_the_period(case):
     meets the clip's kink along the orbit (measured 87.5 % of the pieces within 0.1 mN of it; the
     issue measured 85-90 % over the capped settings)."""
     motion = case[0]
-    assert np.mean(motion.F >= PAPER_CAP - 1e-4) > 0.5
+    assert np.mean(motion.F >= PAPER_CAP - 1e-4) > 0.5   # reason: "at the cap" within 0.1 mN; a property
 
 
 def test_the_verdict_is_the_same_when_the_step_is_halved_at_30_deg_and_4_N(body, case):
