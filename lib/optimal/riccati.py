@@ -284,10 +284,7 @@ def loop_rhs(lqr, F_max: float, beta_max: float | None):
         ``rhs(t, X, t_in)``: the rates (M, 6) of the states X (M, 6) (m, m, rad, m/s, m/s, rad/s)
         at t (s), the inputs read at ``t_in`` (s).
     """
-    fmax = checks.number("F_max", F_max, positive=True, finite=False, unit="N")
-    bmax = -1.0 if beta_max is None else checks.number("beta_max", beta_max, positive=True, maximum=math.pi,
-                                                       unit="rad")
-    arrays = _lqr_arrays(lqr)
+    fmax, bmax, arrays = _limited_lqr(lqr, F_max, beta_max)
     if arrays is None:
         return None
 
@@ -325,10 +322,7 @@ def loop_steps(lqr, F_max: float, beta_max: float | None, edges, n, h, inside):
         code 1 where a stage's state exceeds ``blowup`` or its rate is not finite, 2 where a step
         ends non-finite, 0 otherwise.
     """
-    fmax = checks.number("F_max", F_max, positive=True, finite=False, unit="N")
-    bmax = -1.0 if beta_max is None else checks.number("beta_max", beta_max, positive=True, maximum=math.pi,
-                                                       unit="rad")
-    arrays = _lqr_arrays(lqr)
+    fmax, bmax, arrays = _limited_lqr(lqr, F_max, beta_max)
     if arrays is None:
         return None
     e, hh = np.ascontiguousarray(edges, dtype=float), np.ascontiguousarray(h, dtype=float)
@@ -396,6 +390,15 @@ def closed_loop_rhs(lqr):
         _closed_rhs(float(t), float(t_in), np.ascontiguousarray(y, dtype=float), *arrays, out)
         return out
     return rhs
+
+
+def _limited_lqr(lqr, F_max, beta_max) -> tuple:
+    """The limits checked (the angle limit -1 for none, as the kernels read it) and the LQR's
+    arrays (None where it is not one the kernels run): (F_max, beta_max, arrays)."""
+    fmax = checks.number("F_max", F_max, positive=True, finite=False, unit="N")
+    bmax = -1.0 if beta_max is None else checks.number("beta_max", beta_max, positive=True, maximum=math.pi,
+                                                       unit="rad")
+    return fmax, bmax, _lqr_arrays(lqr)
 
 
 def _lqr_arrays(lqr) -> tuple | None:
