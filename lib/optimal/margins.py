@@ -406,6 +406,8 @@ def issue_study(body: Body, gains: Gains, R: float, Theta: float, *, fraction: f
         ``margin`` (:func:`margin_cases`' table), ``wrong`` (:func:`wrong_model_cases`),
         ``second`` (:func:`eight_comparison`).
     """
+    checks.instance("body", body, Body)
+    checks.instance("gains", gains, Gains)
     lim = cached(limits_study, body, gains, R, Theta)
     motions = {s: (lim["cap_chain"][0] if s[0] is None else lim["motions"][s]) for s in MARGIN_SETTINGS}
     margin = margin_cases(body, motions, fraction=fraction)
