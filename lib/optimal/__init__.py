@@ -13,7 +13,9 @@
 * :mod:`.demand`: the force that exact tracking of C and of P needs over Fig. 5's grid;
 * :mod:`.loop`: any of the book's closed loops decided by the book's orbit procedure and measured;
 * :mod:`.study` and :mod:`.compare`: the chapter's computations, each one call shared with the
-  report, and every law of the book under each limit setting beside the best motion and the bound.
+  report, and every law of the book under each limit setting beside the best motion and the bound;
+* :mod:`.margins`: the tracker planned with a margin under the limits, run on a wrong plant and
+  under a push, and the headline comparison on a second eight.
 """
 
 from .bound import CapBound, cap_bound, exact_peak_force
