@@ -52,13 +52,13 @@ __all__ = ["MARGIN", "MARGIN_SETTINGS", "WRONG_DELTA", "PUSH", "SECOND_EIGHT", "
            "tracked_case", "margin_cases", "wrong_model_cases", "eight_comparison", "issue_study",
            "margin_table", "wrong_model_table", "eights_table", "PARAMETER_NAMES"]
 
-#: the margin: the plan's cap as a fraction of the cap in the loop
+#: the margin, the plan's cap as a fraction of the cap in the loop
 MARGIN = 0.9
 #: the settings (angle limit in deg or None, cap in N) of the margin and the wrong model
 MARGIN_SETTINGS = ((None, PAPER_CAP), (30, PAPER_CAP))
 #: the plant's relative error in each parameter, high and low
 WRONG_DELTA = 0.1
-#: the disturbance: a constant world-frame push (N), along x
+#: the disturbance, a constant world-frame push (N) along x
 PUSH = (0.2, 0.0)
 #: the second eight (R in m, Theta in rad/s), a point of Fig. 5's grid where the 4 N cap binds
 SECOND_EIGHT = (1.5, 1.2)
