@@ -50,7 +50,7 @@ from .verdict import NEWTON_TOL, ORBIT_SHIFT_TOL, MotionVerdict, _decide, _ladde
 
 __all__ = ["MARGIN", "MARGIN_SETTINGS", "WRONG_DELTA", "PUSH", "SECOND_EIGHT", "plant_lqr", "pushed_verdict",
            "tracked_case", "margin_cases", "wrong_model_cases", "eight_comparison", "issue_study",
-           "margin_table", "wrong_model_table", "eights_table", "PARAMETER_NAMES"]
+           "margin_table", "wrong_model_table", "eights_table"]
 
 #: the margin, the plan's cap as a fraction of the cap in the loop
 MARGIN = 0.9
@@ -416,7 +416,7 @@ def issue_study(body: Body, gains: Gains, R: float, Theta: float, *, fraction: f
 
 
 #: how the page names the plant's parameters and the push
-PARAMETER_NAMES = {"m": "$m$", "I": "$I_C$", "c": "$c$", "c_phi": r"$c_\varphi$", "a": "$a$", "push": "push"}
+_PARAMETER_NAMES = {"m": "$m$", "I": "$I_C$", "c": "$c$", "c_phi": r"$c_\varphi$", "a": "$a$", "push": "push"}
 
 
 def _tracked_cells(frame: pd.DataFrame) -> dict:
@@ -470,7 +470,7 @@ def wrong_model_table(frame: pd.DataFrame, setting: str, margin: bool) -> pd.Dat
         raise ValueError(f"setting = {setting!r} with margin = {margin} has no rows")
     change = ["0.2 N along x" if p == "push" else f"{d:+.0%}".replace("%", " %")
               for p, d in zip(rows.parameter, rows.delta)]
-    return pd.DataFrame({"plant's": [PARAMETER_NAMES[p] for p in rows.parameter], "change": change,
+    return pd.DataFrame({"plant's": [_PARAMETER_NAMES[p] for p in rows.parameter], "change": change,
                          **_tracked_cells(rows)})
 
 
