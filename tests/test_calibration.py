@@ -4,6 +4,7 @@ study that calibrates them (lib.dynamics.statistics, lib.dynamics.calibration)."
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from lib.dynamics import calibration as cal
@@ -131,3 +132,16 @@ def test_starts_moved_by_a_micrometre_are_far_apart_after_the_burn_in():
     assert fr.attrs["separation"] > 1e3 * cal.START_SPREAD   # reason: decorrelated by chaos, not a bound
     assert (fr.lyapunov > 3 * fr.lyapunov_stderr).all()
     assert (fr.rms_stderr > 0).all() and (fr.drift_stderr > 0).all()
+
+
+def test_the_ratio_table_has_a_row_a_setting_and_a_column_an_estimator():
+    study = pd.DataFrame([dict(setting="30 deg", estimator="exponent", K=32, ratio=0.97, lo=0.78, hi=1.3),
+                          dict(setting="30 deg", estimator="drift", K=32, ratio=0.88, lo=0.7, hi=1.17),
+                          dict(setting="R = 1 m", estimator="exponent", K=64, ratio=0.83, lo=0.71, hi=1.01),
+                          dict(setting="30 deg", estimator=cal.SHORT_BLOCKS, K=32, ratio=1.0, lo=0.8, hi=1.4)])
+    t = cal.ratio_table(study)
+    assert list(t.columns) == ["setting", "K starts", "exponent", "drift"]    # the short blocks left out
+    assert list(t.setting) == ["30 deg", "R = 1 m"] and list(t["K starts"]) == [32, 64]
+    assert t.loc[0, "exponent"] == "0.97 (0.78-1.30)" and t.loc[1, "drift"] == "-"
+    with pytest.raises(ValueError, match="study"):
+        cal.ratio_table(study.drop(columns="lo"))

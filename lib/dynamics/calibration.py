@@ -37,7 +37,8 @@ from ..rotation.verdicts import FIG5_GRID, eight_rotation_sweep
 from ..trajectories import eight
 from .statistics import batch_means, block_statistics, drift_statistics, integrated_time
 
-__all__ = ["ensemble_ratio", "limit_ensemble", "rotation_ensemble", "calibration_study", "LIMIT_DEG", "FIG5_POINTS",
+__all__ = ["ensemble_ratio", "limit_ensemble", "rotation_ensemble", "calibration_study", "ratio_table", "LIMIT_DEG",
+           "FIG5_POINTS",
            "LIMIT_STARTS", "ROTATION_STARTS", "BURN_IN", "LIMIT_PERIODS", "RMS_PERIODS", "START_SPREAD",
            "RATIO_BAND", "LEVEL", "RMS_BLOCK", "SHORT_BLOCKS"]
 
@@ -266,3 +267,32 @@ def calibration_study(body: Body, gains: Gains, *, limit_starts: int = LIMIT_STA
                        level):
             rows.append(dict(r, flow="rotation", chaotic=len(ch), separation=np.nan, tau=np.nan))
     return pd.DataFrame(rows)
+
+
+def ratio_table(study: pd.DataFrame) -> pd.DataFrame:
+    """:func:`calibration_study`'s ratios as the Methods page shows them: one row a setting, its
+    starts K, and one column an estimator, each cell "ratio (interval)", the ratio of the spread
+    over the starts to the mean standard error and its confidence interval; "-" where the setting
+    has no such estimate (the reduced rotation has no RMS distance). The study's rows of the
+    short, fixed blocks (:data:`SHORT_BLOCKS`) are left out.
+
+    Parameters
+    ----------
+    study : pandas.DataFrame
+        The frame of :func:`calibration_study` (columns setting, estimator, K, ratio, lo, hi).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns setting, K starts, then one per estimator, in the study's order.
+    """
+    missing = {"setting", "estimator", "K", "ratio", "lo", "hi"} - set(getattr(study, "columns", ()))
+    if missing:
+        raise ValueError(f"study: a frame of calibration_study, missing columns {sorted(missing)}")
+    cal = study[study.estimator != SHORT_BLOCKS]
+    cells = cal.assign(cell=[f"{r:.2f} ({a:.2f}-{b:.2f})" for r, a, b in zip(cal.ratio, cal.lo, cal.hi)])
+    settings = list(dict.fromkeys(cal.setting))
+    wide = cells.pivot(index="setting", columns="estimator", values="cell").reindex(settings)
+    wide = wide[list(dict.fromkeys(cal.estimator))].fillna("-")
+    starts = cal.groupby("setting").K.first().reindex(settings)
+    return pd.concat([starts.rename("K starts"), wide], axis=1).reset_index()
