@@ -13,16 +13,20 @@ import math
 import numpy as np
 import pandas as pd
 
+from ..allocation import Limits
 from ..machinery import checks
 from ..machinery.kinds import round_directed
 from ..params import Body
 from .bound import cap_bound, exact_peak_force
-from .collocation import ACCEPTED
+from .collocation import ACCEPTED, entry_motion
 from .motion import START_TIE, PeriodicMotion, periodic_motion, return_errors
+from .tracker import periodic_lqr
+from .verdict import motion_verdict
 
 __all__ = ["PAPER_CAP", "CHAPTER_ANGLES_DEG", "SETTINGS", "CAP_REFINED", "MULTISTART_SEED", "setting_label",
            "cap_sweep", "cap_convergence", "limit_motions", "motion_convergence", "multistart", "convergence_table",
-           "motions_table", "mesh_table", "multistart_summary", "multistart_optima", "cap_alone_chain"]
+           "motions_table", "mesh_table", "multistart_summary", "multistart_optima", "cap_alone_chain",
+           "entry_rows"]
 
 #: the paper's force cap (N), Fig. 4
 PAPER_CAP = 4.0
@@ -374,3 +378,41 @@ def mesh_table(conv: dict) -> pd.DataFrame:
                                        for q, u in (("position", "m"), ("heading", "rad"), ("velocity", "m/s"),
                                                     ("rate", "rad/s"))}})
                       for c, f in conv.items()], ignore_index=True)
+
+
+def entry_rows(body: Body, motions: dict, *, periods: int = 2, steps: int = 2,
+               verdict_periods: int = 8) -> pd.DataFrame:
+    """From the paper's start, an entry (:func:`lib.optimal.collocation.entry_motion`) onto each setting's motion, then
+    the periodic LQR: its loop decided by :func:`lib.optimal.verdict.motion_verdict` from the
+    state the entry's integrated inputs reach (at t = periods T, the motion's phase 0).
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    motions : dict
+        (angle limit in deg or None, cap in N or None) -> PeriodicMotion.
+    periods : int
+        Periods of each entry.
+    steps, verdict_periods : int
+        :func:`motion_verdict`'s ``steps`` and ``periods``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row a setting: setting, angle_deg, cap, regime, reached and settled (the entry's end
+        reaches the orbit on both maps; the two maps agree), entry_rms and entry_max (m),
+        entry_time (s), end_position (m) and end_heading (rad), the entry's end against the motion.
+    """
+    checks.instance("body", body, Body)
+    rows = []
+    for (angle, cap), m in motions.items():
+        e = entry_motion(body, m, periods=periods)
+        limits = Limits(cap, None if angle is None else math.radians(angle))
+        v = motion_verdict(body, m, limits=limits, lqr=periodic_lqr(body, m), starts=e.end[None],
+                           steps=steps, periods=verdict_periods)
+        rows.append(dict(setting=setting_label(angle, cap), angle_deg=angle, cap=cap, regime=v.regime,
+                         reached=bool(v.reached[0]), settled=bool(v.settled[0]), entry_rms=e.rms_error,
+                         entry_max=e.max_error, entry_time=periods * m.period, end_position=e.end_gap["position"],
+                         end_heading=e.end_gap["heading"]))
+    return pd.DataFrame(rows)

@@ -1,0 +1,74 @@
+"""The entry manoeuvre from the paper's start onto a best motion found (lib.optimal.collocation
+.entry_motion), and the periodic LQR's verdict from where it ends (lib.optimal.study.entry_rows)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from lib.optimal import motion as mo
+from lib.optimal import study
+from lib.optimal.collocation import ENTRY_PERIODS, entry_motion
+from lib.params import PAPER_DZ0, PAPER_Z0, Body
+
+BODY, R, THETA, DEG = Body(), 2.0, math.pi / 4, math.pi / 180
+
+
+@pytest.fixture(scope="module")
+def capped30():
+    """The eight under beta_max = 30 deg and F_max = 4 N at the default mesh."""
+    return mo.periodic_motion(BODY, R, THETA, F_max=4.0, beta_max=30 * DEG, starts=("paper", "force"))
+
+
+@pytest.fixture(scope="module")
+def entry30(capped30):
+    return entry_motion(BODY, capped30)
+
+
+def test_the_entry_keeps_to_the_limits_and_its_integrated_inputs_end_on_the_motion(capped30, entry30):
+    e = entry30
+    assert e.F.shape == e.beta.shape == (ENTRY_PERIODS * e.nodes,)
+    # exact: the bounds of the NLP, met by IPOPT to its bound tolerance (1e-8 relative)
+    assert e.F.min() >= -1e-6 and e.F.max() <= 4.0 + 1e-6 and np.abs(e.beta).max() <= 30 * DEG + 1e-6
+    # accuracy: degree-3 collocation at 80 intervals a period, the inputs integrated at rtol 1e-10;
+    # the motion's own return error at this mesh is about 1e-7 (measured end gap 6e-8 m)
+    assert e.end_gap["position"] < 1e-5 and e.end_gap["heading"] < 1e-5
+    assert e.end_gap["velocity"] < 1e-4 and e.end_gap["rate"] < 1e-4   # accuracy: as the line above
+    # the entry starts 1 m from the path (the paper's start against C_d(0) = 0), so its largest
+    # distance is that, and its RMS lies between the motion's and it
+    d0 = float(np.hypot(*PAPER_Z0[:2]))
+    assert e.max_error == pytest.approx(d0, abs=0.05)     # reason: the first collocation point, h/9 in
+    assert capped30.rms_error < e.rms_error < d0
+
+
+def test_the_paper_start_reaches_the_orbit_after_the_entry(capped30):
+    rows = study.entry_rows(BODY, {(30, 4.0): capped30})
+    r = rows.iloc[0]
+    assert r.setting == study.setting_label(30, 4.0) and r.regime == "periodic"
+    assert r.reached and r.settled
+    assert r.entry_time == pytest.approx(ENTRY_PERIODS * capped30.period, rel=1e-12)  # exact: a product
+    assert r.end_position < 1e-5                           # accuracy: as the test above
+
+
+def test_an_entry_from_another_start_over_more_periods_ends_on_the_motion(capped30):
+    start = np.concatenate([np.asarray(PAPER_Z0) + [0.3, -0.2, 0.5], PAPER_DZ0])
+    e = entry_motion(BODY, capped30, start, periods=3)
+    assert e.F.size == 3 * e.nodes and e.end_gap["position"] < 1e-5   # accuracy: as above
+
+
+@pytest.mark.parametrize("kw, match", [
+    (dict(periods=0), "periods"), (dict(nodes=4), "nodes"), (dict(degree=6), "degree"),
+    (dict(start=[0.0, 1.0]), "start"), (dict(start=[np.nan] * 6), "start"),
+])
+def test_a_bad_entry_is_refused_naming_its_argument(capped30, kw, match):
+    with pytest.raises((TypeError, ValueError), match=match):
+        entry_motion(BODY, capped30, **kw)
+
+
+def test_an_entry_onto_something_else_than_a_motion_is_refused():
+    with pytest.raises(TypeError, match="motion"):
+        entry_motion(BODY, object())
+    with pytest.raises(TypeError, match="body"):
+        entry_motion("body", object())
