@@ -29,7 +29,7 @@ FMTS = [".1f", ".2f", ".3f", ".4f", ".1e", ".2e", ".2g", ".3g", ".4g"]
 @given(st.floats(min_value=-1e6, max_value=1e6, allow_nan=False, allow_subnormal=False), st.sampled_from(FMTS))
 def test_a_value_rounded_down_is_never_above_it_and_up_never_below(x, fmt):
     down, up, near = (round_directed(x, fmt, r) for r in ("down", "up", "nearest"))
-    exact = Decimal(x)
+    exact = Decimal(repr(x))          # the value as Python writes it, within half an ulp of the double
     assert Decimal(down) <= exact <= Decimal(up)
     # the two directed roundings are the neighbours of the exact value on the format's grid:
     # the nearest is one of them (ties aside, where both are equally near)
@@ -44,6 +44,11 @@ def test_the_certified_bound_of_the_issue_is_written_below_itself():
     assert kinds.best_found(0.10776, ".4f").text() == "0.1078"
     assert kinds.upper_bound(0.10770, ".3g").text() == "0.108"
     assert kinds.exact(0.10769, ".3f").text() == "0.108"
+
+
+def test_a_value_with_a_short_decimal_is_not_pushed_past_it_by_its_binary_tail():
+    # 0.19 is stored as 0.19000000000000000222...: rounded up to 3 decimals it stays 0.190
+    assert round_directed(0.19, ".3f", "up") == "0.190" and round_directed(0.29, ".2f", "down") == "0.29"
 
 
 def test_an_estimate_is_written_with_its_error_rounded_up():

@@ -72,3 +72,17 @@ def test_an_entry_onto_something_else_than_a_motion_is_refused():
         entry_motion(BODY, object())
     with pytest.raises(TypeError, match="body"):
         entry_motion("body", object())
+
+
+def test_the_entry_table_rounds_its_distances_up_and_says_where_the_maps_disagree():
+    import pandas as pd
+    rows = pd.DataFrame([dict(setting="30 deg", reached=True, settled=True, entry_rms=0.1195, entry_max=0.98231,
+                              end_position=2.7e-6),
+                         dict(setting="4 N", reached=False, settled=False, entry_rms=0.19, entry_max=0.98,
+                              end_position=5e-8),
+                         dict(setting="90 deg", reached=False, settled=True, entry_rms=0.1, entry_max=0.9,
+                              end_position=1e-6)])
+    t = study.entry_table(rows)
+    assert list(t["paper's start reaches"]) == ["yes", "undecided", "no"]
+    assert list(t["entry RMS (m)"]) == ["0.120", "0.190", "0.100"] and t["entry largest (m)"][0] == "0.983"
+    assert t["end gap (m)"][0] == "3e-06"

@@ -76,14 +76,17 @@ def round_directed(value: float, fmt: str, rounding: str) -> str:
     Returns
     -------
     str
-        The text; ``float(text)`` lies on the stated side of ``value`` (or equals it).
+        The text; it lies on the stated side of ``repr(value)``, the value as Python writes it
+        (within half an ulp of the double: far below any bound's own accuracy).
     """
     p, kind = _check_fmt(fmt)
     if rounding not in _MODES:
         raise ValueError(f"rounding: 'down', 'up' or 'nearest', got {rounding!r}")
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise ValueError(f"value: a finite number, got {value!r}")
-    d = Decimal(float(value))                      # the double's exact decimal value
+    # the double as Python writes it (its shortest decimal that reads back as the same double, within
+    # half an ulp of its exact value): 0.19 is rounded as 0.19, not as 0.19000000000000000222
+    d = Decimal(repr(float(value)))
     if kind == "f" or d == 0:
         exponent = -p if kind == "f" else 0
     else:                                          # 'e': p digits after the first; 'g': p in all

@@ -26,7 +26,7 @@ from .verdict import motion_verdict
 __all__ = ["PAPER_CAP", "CHAPTER_ANGLES_DEG", "SETTINGS", "CAP_REFINED", "MULTISTART_SEED", "setting_label",
            "cap_sweep", "cap_convergence", "limit_motions", "motion_convergence", "multistart", "convergence_table",
            "motions_table", "mesh_table", "multistart_summary", "multistart_optima", "cap_alone_chain",
-           "entry_rows"]
+           "entry_rows", "entry_table"]
 
 #: the paper's force cap (N), Fig. 4
 PAPER_CAP = 4.0
@@ -416,3 +416,29 @@ def entry_rows(body: Body, motions: dict, *, periods: int = 2, steps: int = 2,
                          entry_max=e.max_error, entry_time=periods * m.period, end_position=e.end_gap["position"],
                          end_heading=e.end_gap["heading"]))
     return pd.DataFrame(rows)
+
+
+def entry_table(rows: pd.DataFrame) -> pd.DataFrame:
+    """:func:`entry_rows` as the page shows it: setting, whether the paper's start reaches the
+    orbit after the entry ("yes", "no", or "undecided" where the verdict's two maps disagree), the
+    entry's RMS and largest distance of C from the path (m, rounded up: values of a motion that
+    exists) and the gap of its integrated end to the motion's state (m, one significant digit, up).
+
+    Parameters
+    ----------
+    rows : pandas.DataFrame
+        The frame of :func:`entry_rows`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The cells, formatted.
+    """
+    up = lambda v, f: round_directed(float(v), f, "up")      # noqa: E731
+    return pd.DataFrame({
+        "setting": rows.setting,
+        "paper's start reaches": ["yes" if r else ("no" if s else "undecided")
+                                  for r, s in zip(rows.reached, rows.settled)],
+        "entry RMS (m)": [up(v, ".3f") for v in rows.entry_rms],
+        "entry largest (m)": [up(v, ".3f") for v in rows.entry_max],
+        "end gap (m)": [up(v, ".0e") for v in rows.end_position]})
