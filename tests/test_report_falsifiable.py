@@ -447,8 +447,25 @@ def test_second_eight_row_fails_with_each_clause(monkeypatch, kw, status):
     assert _status(monkeypatch, "second-eight", cached=_cached_issue51(_issue51(**kw))) == status
 
 
+def _entries(n=9, unreached=(), unsettled_regime=(), gap=6e-6):
+    return pd.DataFrame([dict(setting=f"s{i}", regime="undecided" if i in unsettled_regime else "periodic",
+                              reached=i not in unreached, settled=True, end_position=gap) for i in range(n)],
+                        columns=["setting", "regime", "reached", "settled", "end_position"])
+
+
+@pytest.mark.parametrize("kw, status", [
+    ({}, "extended"),
+    ({"unreached": (8,)}, "not reproducible"),                 # one setting not reached from the entry
+    ({"unsettled_regime": (0,)}, "not reproducible"),          # one loop not periodic
+    ({"gap": 2e-4}, "not reproducible"),                       # the entry ends off the motion
+    ({"n": 0}, "not reproducible"),                            # no setting at all
+])
+def test_entry_row_fails_with_each_clause(monkeypatch, kw, status):
+    assert _status(monkeypatch, "entry", entries=lambda body, gains: _entries(**kw)) == status
+
+
 def test_every_extension_row_has_a_falsifying_test():
     tested = {"limit-lyapunov", "limit-mirror", "wrong-model", "slow-eights", "window", "weight-limit",
               "percussion-circle", "percussion-map", "cap-bound", "angle-optimum", "optimal-tracker", "fig5-map",
-              "tracker-margin", "tracker-wrong-model", "second-eight"}
+              "tracker-margin", "tracker-wrong-model", "second-eight", "entry"}
     assert set(ITEMS) == tested

@@ -25,6 +25,7 @@ from ..dynamics.verdicts import ORBIT_REGIMES, SIGMAS, held
 from ..percussion import circle_lock_radius, percussion_fig5_map
 from ..percussion.claims import paper_circle_of_p
 from ..optimal import margins
+from ..optimal.collocation import ENTRY_PERIODS
 from ..optimal.motion import verify_motion
 from ..optimal.study import PAPER_CAP
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
@@ -374,6 +375,20 @@ def _check_second_eight() -> Outcome:
                    merit_kind=Kind.UPPER.value)
 
 
+def _check_entry() -> Outcome:
+    rows = studies.entries(Body(), Gains())
+    # every setting: the loop periodic and the entry's end reaching its orbit on both maps; the
+    # entry's integrated inputs end within 1e-4 of the motion (collocation and integration: 1e-5)
+    gap = float(rows.end_position.max()) if len(rows) else math.inf
+    ok = len(rows) > 0 and bool((rows.regime == "periodic").all() and rows.reached.all()) and gap < 1e-4
+    return Outcome(legend_status(ok, extension=True), float(rows.reached.sum()),
+                   f"limit settings of {len(rows)} at which the paper's start reaches the best motion found's "
+                   f"orbit after an open-loop entry of {ENTRY_PERIODS} periods",
+                   f"the entry (collocation, open) ends within "
+                   f"{upper_bound(gap, '.0e').text() if math.isfinite(gap) else 'no'} m of the motion; the "
+                   "periodic LQR decided from there on both maps", merit_kind=Kind.COUNT.value)
+
+
 def items() -> list[Item]:
     """The extension rows, in the order of the chapters."""
     I = Item  # noqa: E741
@@ -408,4 +423,6 @@ def items() -> list[Item]:
           "chapters/08_optimal", "extended", _check_tracker_wrong_model),
         I("second-eight", "Sec. 5, extended: the paper's law against the bound on a second eight",
           "chapters/08_optimal", "extended", _check_second_eight),
+        I("entry", "Sec. 5, extended: from the paper's start onto the best motion, by an entry and the LQR",
+          "chapters/08_optimal", "extended", _check_entry),
     ]

@@ -17,6 +17,7 @@ import math
 import numpy as np
 
 from ..machinery.cache import cached
+from ..optimal.collocation import ENTRY_PERIODS
 from ..optimal.study import PAPER_CAP
 from ..params import Body, Gains
 from ..percussion import percussion_fig5_map
@@ -62,6 +63,8 @@ LABELS = {
         "fd_paper_cap": ("m", "paper's law"), "fd_opt_cap": ("m", "controller tracking the best motion"),
         "fd_e2_R": ("m", "second eight"), "fd_e2_Theta": ("rad/s", "second eight"),
         "fd_e2_ratio": ("times", "second eight"), "fd_e1_ratio": ("times", "paper's law"),
+        "fd_entry_reached": ("settings", "paper's start"), "fd_entry_n": ("limit settings", "entry"),
+        "fd_entry_periods": ("periods", "entry"),
     },
     "chapters/01_model": {
         "n_wrong_rows": ("row", "drift"), "wrong_row": ("row", "wrong sign"),
@@ -103,7 +106,8 @@ LABELS = {
         "opt_paper_undecided": ("settings", "undecided"),
         "map_ratio_median": ("times", "median"), "map_FP_max": ("N", "peak force"),
         "mg_cap_cost_rms": ("m", "RMS"), "mg_e2_ratio": ("times", "least possible"),
-        "mg_e1_ratio": ("times", "least possible"),
+        "mg_e1_ratio": ("times", "least possible"), "entry_reached": ("settings", "entry"),
+        "entry_periods": ("periods", "entry"),
     },
 }
 
@@ -149,6 +153,7 @@ def front_page() -> dict[str, float | Number]:
     lim = studies.limits_comparison(Body(), Gains())                            # Chapter 8's call
     table = lim["table"]
     cap_only = table[(table.cap == PAPER_CAP) & table.angle_deg.isna()].set_index("law")
+    entries = studies.entries(Body(), Gains())                            # Chapter 8's call
     out = {
         "fd_eq6_t": OPEN_LOOP_HORIZON, "fd_eq6_pos": pos, "fd_eq6_heading": heading, "fd_fig3": f["fig3"].merit,
         "fd_mirror_heading": gap[2], "fd_mirror_rate": gap[5], "fd_mirror_pos": float(math.hypot(gap[0], gap[1])),
@@ -163,6 +168,8 @@ def front_page() -> dict[str, float | Number]:
         "fd_opt_cap": best_found(float(cap_only.max_error["optimal"]), ".4f"),
         "fd_e2_R": SECOND_EIGHT[0], "fd_e2_Theta": SECOND_EIGHT[1], "fd_e2_ratio": f["second-eight"].number(".2f"),
         "fd_e1_ratio": upper_bound(float(cap_only.max_error["paper"]) / lim["bound"].max_error, ".2f"),
+        "fd_entry_reached": int(entries.reached.sum()), "fd_entry_n": len(entries),
+        "fd_entry_periods": ENTRY_PERIODS,
     }
     assert set(out) == set(LABELS["intro"]), set(out) ^ set(LABELS["intro"])
     return out
