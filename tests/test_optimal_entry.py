@@ -86,3 +86,15 @@ def test_the_entry_table_rounds_its_distances_up_and_says_where_the_maps_disagre
     assert list(t["paper's start reaches"]) == ["yes", "undecided", "no"]
     assert list(t["entry RMS (m)"]) == ["0.120", "0.190", "0.100"] and t["entry largest (m)"][0] == "0.983"
     assert t["end gap (m)"][0] == "3e-06"
+
+
+def test_the_entry_figure_draws_the_path_the_entry_and_the_motion(capped30, entry30):
+    import matplotlib
+    matplotlib.use("Agg")
+    from lib.figures.optimal import plot_entry
+    from lib.trajectories import eight
+    fig = plot_entry(entry30, capped30, eight(R, THETA), "30 deg + 4 N")
+    lines = fig.axes[0].get_lines()
+    assert len(lines) == 5
+    # the entry's drawn path starts at the paper's start (exact: the NLP's bounds fix it)
+    assert lines[1].get_xdata()[0] == PAPER_Z0[0] and lines[1].get_ydata()[0] == PAPER_Z0[1]

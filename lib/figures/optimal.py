@@ -152,3 +152,42 @@ def plot_basin(frame, title: str = "", ax=None):
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     fig.tight_layout()
     return fig
+
+
+def plot_entry(entry, motion, path, title: str = "", ax=None):
+    """An entry manoeuvre (:func:`lib.optimal.collocation.entry_motion`): the path (dashed), C's
+    path during the entry from the start (cross) to its end (circle, on the motion), and the
+    motion's path over one period after it.
+
+    Parameters
+    ----------
+    entry : lib.optimal.collocation.Entry
+        The entry (its ``path``: t (s), x, y (m)).
+    motion : PeriodicMotion
+        The motion it enters.
+    path : Reference
+        The path (:func:`lib.trajectories.eight`), for C_d.
+    title : str
+        The panel's title.
+    ax : matplotlib.axes.Axes, optional
+        The axis.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, ax = (plt.subplots(figsize=(6.4, 3.8)) if ax is None else (ax.figure, ax))
+    t = np.linspace(0.0, motion.period, 801)
+    zd, z = path.z(t), motion.state(t)[0]
+    ax.plot(zd[:, 0], zd[:, 1], "k--", lw=1, label="the path")
+    ax.plot(entry.path[:, 1], entry.path[:, 2], "C3-", lw=1.3, label="C during the entry")
+    ax.plot(z[:, 0], z[:, 1], "C0-", lw=1.5, label="C on the motion after it")
+    ax.plot(*entry.path[0, 1:], "kx", ms=8, label="the paper's start")
+    ax.plot(*entry.path[-1, 1:], "o", mfc="none", mec="C3", ms=7, label="the entry's end")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_aspect("equal")
+    ax.set_title(title, fontsize=9)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    fig.tight_layout()
+    return fig

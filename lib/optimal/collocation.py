@@ -302,8 +302,8 @@ def entry_transcription(body: Body, nodes: int, degree: int) -> Transcription:
 class Entry:
     """An entry manoeuvre (:func:`entry_motion`): inputs F (N), beta (rad) held on each interval
     of [0, periods T]; C's RMS and largest distance from the path over it (m, at the collocation
-    points); ``end``, the state its integrated inputs reach (m, m, rad, m/s, m/s, rad/s; heading
-    brought back by whole turns to the motion's at t = 0) and ``end_gap``, its mismatch there."""
+    points, ``path`` (M, 3): t (s), x, y (m) there); ``end``, the state its integrated inputs reach
+    (heading brought back by whole turns to the motion's at t = 0), ``end_gap`` its mismatch."""
 
     F: np.ndarray
     beta: np.ndarray
@@ -313,7 +313,7 @@ class Entry:
     end_gap: dict
     periods: int
     nodes: int
-    status: str
+    path: np.ndarray
 
 
 def entry_motion(body: Body, motion: PeriodicMotion, start=None, *, periods: int = ENTRY_PERIODS,
@@ -368,8 +368,7 @@ def entry_motion(body: Body, motion: PeriodicMotion, start=None, *, periods: int
     X, u = np.concatenate([z, dz], -1), _clip(np.stack(motion.inputs(t_mid), -1), motion.F_max, motion.beta_max)
     X[..., 2] += lap
     X[0, 0] = x0
-    zT, dzT = motion.state(periods * motion.period)
-    target = np.concatenate([zT, dzT]) + np.array([0, 0, lap, 0, 0, 0])
+    target = np.concatenate(motion.state(periods * motion.period)) + np.array([0, 0, lap, 0, 0, 0])
     tr = entry_transcription(body, N, degree)
     lo, hi = (b.reshape(N, tr.block) for b in _bounds(tr, motion.F_max, motion.beta_max))
     lo[0, :6] = hi[0, :6] = x0
@@ -388,7 +387,8 @@ def entry_motion(body: Body, motion: PeriodicMotion, start=None, *, periods: int
     end = np.concatenate([z1, dz1]) - np.array([0, 0, lap + 2 * np.pi * motion.turns * periods, 0, 0, 0])
     gap = np.abs(end - np.concatenate(motion.state(0.0)))
     return Entry(F=us[:, 0], beta=us[:, 1], rms_error=float(np.sqrt(max((e2 @ tab.B).mean(), 0.0))),
-                 max_error=float(np.sqrt(e2.max())), end=end, periods=periods, nodes=nodes, status=status,
+                 max_error=float(np.sqrt(e2.max())), end=end, periods=periods, nodes=nodes,
+                 path=np.c_[t_col.ravel(), Xs[..., :2].reshape(-1, 2)],
                  end_gap={"position": float(np.hypot(gap[0], gap[1])), "heading": float(gap[2]),
                           "velocity": float(np.hypot(gap[3], gap[4])), "rate": float(gap[5])})
 
