@@ -323,7 +323,7 @@ def entry_motion(body: Body, motion: PeriodicMotion, start=None, *, periods: int
     state from the start to the motion's (its heading on the branch nearest the start's), by
     the Legendre collocation of :func:`entry_transcription` from the
     motion itself as first guess. Its inputs are then integrated from the start by the book's
-    integrator, so that :attr:`Entry.end` is what the model reaches, not what the collocation
+    integrator, so that ``Entry.end`` is what the model reaches, not what the collocation
     says. Open loop: it is a plan, which the periodic LQR takes over at its end.
 
     Parameters
