@@ -98,3 +98,10 @@ def test_the_entry_figure_draws_the_path_the_entry_and_the_motion(capped30, entr
     assert len(lines) == 5
     # the entry's drawn path starts at the paper's start (exact: the NLP's bounds fix it)
     assert lines[1].get_xdata()[0] == PAPER_Z0[0] and lines[1].get_ydata()[0] == PAPER_Z0[1]
+
+
+def test_entry_rows_refuse_what_is_not_a_dict_of_motions():
+    with pytest.raises(TypeError, match="motions"):
+        study.entry_rows(BODY, [1, 2])
+    with pytest.raises(TypeError, match="motions"):
+        study.entry_rows(BODY, {(30, 4.0): "a motion"})

@@ -405,6 +405,8 @@ def entry_rows(body: Body, motions: dict, *, periods: int = 2, steps: int = 2,
         entry_time (s), end_position (m) and end_heading (rad), the entry's end against the motion.
     """
     checks.instance("body", body, Body)
+    if not isinstance(motions, dict) or not all(isinstance(m, PeriodicMotion) for m in motions.values()):
+        raise TypeError("motions must be a dict (angle limit, cap) -> PeriodicMotion (limit_motions' result)")
     rows = []
     for (angle, cap), m in motions.items():
         e = entry_motion(body, m, periods=periods)

@@ -60,7 +60,7 @@ LABELS = {
         "fd_turns": ("points", "turns round"), "fd_weight": ("", "weight"),
         "fd_p_held": ("points", "law for P"), "fd_p_grid": ("points", "held"),
         "fd_paper_held": ("points", "paper's law"), "fd_bound": ("m", "lower bound"),
-        "fd_paper_cap": ("m", "paper's law"), "fd_opt_cap": ("m", "controller tracking the best motion"),
+        "fd_paper_cap": ("m", "paper's law"), "fd_opt_cap": ("m", "controller tracking the motion found best"),
         "fd_e2_R": ("m", "second eight"), "fd_e2_Theta": ("rad/s", "second eight"),
         "fd_e2_ratio": ("times", "second eight"), "fd_e1_ratio": ("times", "paper's law"),
         "fd_entry_reached": ("settings", "paper's start"), "fd_entry_n": ("limit settings", "entry"),
