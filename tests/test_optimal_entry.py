@@ -105,3 +105,13 @@ def test_entry_rows_refuse_what_is_not_a_dict_of_motions():
         study.entry_rows(BODY, [1, 2])
     with pytest.raises(TypeError, match="motions"):
         study.entry_rows(BODY, {(30, 4.0): "a motion"})
+
+
+def test_the_basin_with_the_entry_reaches_the_orbit_from_moved_starts(capped30):
+    from lib.allocation import Limits
+    fr = study.entry_basin(BODY, capped30, Limits(4.0, 30 * DEG), heading_offsets=[0.0, math.pi / 2],
+                           position_offsets=[0.5])
+    assert list(fr.columns) == ["heading_offset", "x_offset", "entry", "reached", "settled"]
+    assert fr.entry.all() and fr.reached.all() and fr.settled.all()
+    with pytest.raises(TypeError, match="limits"):
+        study.entry_basin(BODY, capped30, None)

@@ -16,7 +16,7 @@ import pandas as pd
 from ..allocation import Limits
 from ..machinery import checks
 from ..machinery.kinds import round_directed
-from ..params import Body
+from ..params import PAPER_DZ0, PAPER_Z0, Body
 from .bound import cap_bound, exact_peak_force
 from .collocation import ACCEPTED, entry_motion
 from .motion import START_TIE, PeriodicMotion, periodic_motion, return_errors
@@ -26,7 +26,7 @@ from .verdict import motion_verdict
 __all__ = ["PAPER_CAP", "CHAPTER_ANGLES_DEG", "SETTINGS", "CAP_REFINED", "MULTISTART_SEED", "setting_label",
            "cap_sweep", "cap_convergence", "limit_motions", "motion_convergence", "multistart", "convergence_table",
            "motions_table", "mesh_table", "multistart_summary", "multistart_optima", "cap_alone_chain",
-           "entry_rows", "entry_table"]
+           "entry_rows", "entry_table", "entry_basin"]
 
 #: the paper's force cap (N), Fig. 4
 PAPER_CAP = 4.0
@@ -444,3 +444,47 @@ def entry_table(rows: pd.DataFrame) -> pd.DataFrame:
         "entry RMS (m)": [up(v, ".3f") for v in rows.entry_rms],
         "entry largest (m)": [up(v, ".3f") for v in rows.entry_max],
         "end gap (m)": [up(v, ".0e") for v in rows.end_position]})
+
+
+def entry_basin(body: Body, motion: PeriodicMotion, limits: Limits, *,
+                heading_offsets=np.linspace(-np.pi, np.pi, 5)[:-1], position_offsets=(-1.0, 0.0, 1.0),
+                periods: int = 2, steps: int = 2, verdict_periods: int = 8) -> pd.DataFrame:
+    """The basin of :func:`lib.optimal.verdict.basin` with the entry: from the paper's start at
+    rest moved by each heading offset (rad) and each offset of x (m), an entry
+    (:func:`lib.optimal.collocation.entry_motion`) onto ``motion``, then its periodic LQR decided
+    from the entry's end by :func:`motion_verdict` on both maps. A start whose entry IPOPT does
+    not solve is recorded as not reached, ``entry`` False.
+
+    Parameters
+    ----------
+    body, motion, limits
+        The body, the motion and its limits.
+    heading_offsets, position_offsets : array_like
+        The grid of offsets (rad, m).
+    periods, steps, verdict_periods : int
+        The entry's periods, and :func:`motion_verdict`'s ``steps`` and ``periods``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns heading_offset (rad), x_offset (m), entry, reached, settled.
+    """
+    checks.instance("body", body, Body)
+    checks.instance("motion", motion, PeriodicMotion)
+    checks.instance("limits", limits, Limits)
+    H, X = np.meshgrid(checks.array("heading_offsets", heading_offsets, ndim=1, nonempty=True),
+                       checks.array("position_offsets", position_offsets, ndim=1, nonempty=True))
+    S0 = np.tile(np.concatenate([PAPER_Z0, PAPER_DZ0]), (H.size, 1))
+    S0[:, 2] += H.ravel()
+    S0[:, 0] += X.ravel()
+    ends, found = [], []
+    for s in S0:
+        try:
+            ends.append(entry_motion(body, motion, s, periods=periods).end), found.append(True)
+        except RuntimeError:
+            ends.append(np.concatenate(motion.state(0.0)) + 1.0), found.append(False)   # far: not reached
+    v = motion_verdict(body, motion, limits=limits, lqr=periodic_lqr(body, motion), starts=np.array(ends),
+                       steps=steps, periods=verdict_periods)
+    found = np.array(found)
+    return pd.DataFrame(dict(heading_offset=H.ravel(), x_offset=X.ravel(), entry=found, reached=v.reached & found,
+                             settled=v.settled | ~found))
