@@ -16,12 +16,12 @@ import pandas as pd
 from ..allocation import Limits
 from ..machinery import checks
 from ..machinery.kinds import round_directed
-from ..params import PAPER_DZ0, PAPER_Z0, Body
+from ..params import Body
 from .bound import cap_bound, exact_peak_force
 from .collocation import ACCEPTED, entry_motion
 from .motion import START_TIE, PeriodicMotion, periodic_motion, return_errors
 from .tracker import periodic_lqr
-from .verdict import motion_verdict
+from .verdict import motion_verdict, offset_starts
 
 __all__ = ["PAPER_CAP", "CHAPTER_ANGLES_DEG", "SETTINGS", "CAP_REFINED", "MULTISTART_SEED", "setting_label",
            "cap_sweep", "cap_convergence", "limit_motions", "motion_convergence", "multistart", "convergence_table",
@@ -472,11 +472,7 @@ def entry_basin(body: Body, motion: PeriodicMotion, limits: Limits, *,
     checks.instance("body", body, Body)
     checks.instance("motion", motion, PeriodicMotion)
     checks.instance("limits", limits, Limits)
-    H, X = np.meshgrid(checks.array("heading_offsets", heading_offsets, ndim=1, nonempty=True),
-                       checks.array("position_offsets", position_offsets, ndim=1, nonempty=True))
-    S0 = np.tile(np.concatenate([PAPER_Z0, PAPER_DZ0]), (H.size, 1))
-    S0[:, 2] += H.ravel()
-    S0[:, 0] += X.ravel()
+    H, X, S0 = offset_starts(heading_offsets, position_offsets)     # the LQR basin's grid
     ends, found = [], []
     for s in S0:
         try:

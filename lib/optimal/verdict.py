@@ -43,7 +43,7 @@ from .tracker import (DEFAULT_STARTS, NEWTON_ITER, NEWTON_STALL, NEWTON_TOL, REA
                       PeriodicLQR, _check_loop, _edges, _inside_bounds, _limits, _loop, _piecewise_ivp, _reference,
                       periodic_lqr)
 
-__all__ = ["MotionVerdict", "motion_verdict", "basin", "ORBIT_SHIFT_TOL", "MULTIPLIER_TOL", "FINE_RTOL"]
+__all__ = ["MotionVerdict", "motion_verdict", "basin", "offset_starts", "ORBIT_SHIFT_TOL", "MULTIPLIER_TOL", "FINE_RTOL"]
 
 #: the most the orbit may move (max-norm, state units) when the step is halved, a tenth of the
 #: reach tolerance :data:`lib.optimal.tracker.REACH_TOL`, so that a start's distance to it is
@@ -300,6 +300,27 @@ def _advance_rows(advance, X):
         return out
 
 
+def offset_starts(heading_offsets, position_offsets) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The basins' grid: the paper's start at rest moved by each heading offset and each offset of x.
+
+    Parameters
+    ----------
+    heading_offsets, position_offsets : array_like
+        1-D offsets (rad, m), checked.
+
+    Returns
+    -------
+    H, X, starts : numpy.ndarray
+        The offsets on a meshgrid and the starts (H.size, 6).
+    """
+    H, X = np.meshgrid(checks.array("heading_offsets", heading_offsets, ndim=1, nonempty=True),
+                       checks.array("position_offsets", position_offsets, ndim=1, nonempty=True))
+    S0 = np.tile(DEFAULT_STARTS[0], (H.size, 1))
+    S0[:, 2] += H.ravel()
+    S0[:, 0] += X.ravel()
+    return H, X, S0
+
+
 def basin(body: Body, motion, verdict: MotionVerdict, *, limits: Limits | None = None, lqr: PeriodicLQR | None = None,
           heading_offsets=np.linspace(-np.pi, np.pi, 13), position_offsets=np.linspace(-1.0, 1.0, 9),
           periods: int = 8, steps: int | None = None):
@@ -319,17 +340,12 @@ def basin(body: Body, motion, verdict: MotionVerdict, *, limits: Limits | None =
     """
     _check_loop(body, motion, limits, lqr)
     checks.instance("verdict", verdict, MotionVerdict)
-    hs = checks.array("heading_offsets", heading_offsets, ndim=1, nonempty=True)
-    xs = checks.array("position_offsets", position_offsets, ndim=1, nonempty=True)
+    H, X, S0 = offset_starts(heading_offsets, position_offsets)
     periods = checks.integer("periods", periods, minimum=1)
     steps = max(verdict.steps or 8, 0 if steps is None else checks.integer("steps", steps, minimum=1))
     if not np.isfinite(verdict.x).all():
         raise ValueError("verdict has no orbit (regime 'undecided'): no basin to draw")
     lqr = lqr or periodic_lqr(body, motion)
-    H, X = np.meshgrid(hs, xs)
-    S0 = np.tile(DEFAULT_STARTS[0], (H.size, 1))
-    S0[:, 2] += H.ravel()
-    S0[:, 0] += X.ravel()
     d = []
     for s in (steps, 2 * steps):
         advance, S = _period_map(lqr, *_limits(limits, motion), s), S0
