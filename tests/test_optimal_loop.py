@@ -9,7 +9,10 @@ from scipy.optimize import linear_sum_assignment
 from lib import trajectories
 from lib.allocation import Limits
 from lib.closed_loop import ClosedLoop, reference_of
-from lib.optimal.loop import LOOP_OPTIONS, FlowMap, loop_verdict, run_periods, steady_measures
+from lib.machinery import checks
+from lib.optimal.loop import (LOOP_OPTIONS, FlowMap, halved_verdict, loop_verdict, run_periods,
+                              steady_measures)
+from lib.optimal.verdict import MULTIPLIER_TOL, ORBIT_SHIFT_TOL
 from lib.params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from lib.rotation.circle import circle_eigenvalues, circle_equilibria
 
@@ -93,6 +96,47 @@ def test_bad_arguments_are_refused_before_any_integration(kw, name):
     args.update(kw)
     with pytest.raises((TypeError, ValueError), match=name):
         loop_verdict(args.pop("rates"), args.pop("period"), args.pop("s0"), **args)
+
+
+def test_halving_the_step_decides_the_paper_circle_periodic_once_the_orbit_stops_moving():
+    # from 32 RK4 steps a period the orbit still moves when the step is halved (measured 8e-4), so
+    # the steps are doubled; the pair that agrees has moved the orbit by less than the tolerance
+    ref = trajectories.circle(R0, TH0)
+    _, rates = _rates(ref)
+    v = halved_verdict(rates, ref.period, np.r_[PAPER_Z0, PAPER_DZ0], reference_turns=1, steps=32, max_steps=256)
+    assert v.regime == "periodic" and v.period == 1 and v.turns == 0 and v.reason == ""
+    assert v.steps > 32 and v.orbit_shift <= ORBIT_SHIFT_TOL and v.floquet_change <= MULTIPLIER_TOL
+    # the finer map's orbit against the closed form (C on the circle, p = p0): RK4's error on a
+    # smooth field falls 2^4 = 16 times when the step is halved, so the finer map's error is
+    # about the shift / 15, and the shift itself bounds it
+    p0 = circle_equilibria(BODY, R0, TH0)[0]
+    heading = math.remainder(v.orbit[2] - math.pi / 2 - p0, 2 * math.pi)
+    err = max(abs(v.orbit[0] - R0), abs(v.orbit[1]), abs(heading))
+    assert err <= v.orbit_shift + 1e-6  # accuracy: the shift (measured 4.9e-5; error 3.2e-6) + 100 x Newton's 1e-8
+
+
+@pytest.mark.parametrize("steps, said", [(8, "the verdict changed when the step was halved from 8 to 16"),
+                                         (16, "the orbit moved by")])
+def test_a_map_too_coarse_to_converge_is_undecided_because_halving_the_step_changed_it(steps, said):
+    # 8 steps a period find no orbit and 16 find one; 16 and 32 find it 0.025 apart (measured):
+    # with no doubling allowed (max_steps = 2 steps) neither pair agrees
+    ref = trajectories.circle(R0, TH0)
+    _, rates = _rates(ref)
+    v = halved_verdict(rates, ref.period, np.r_[PAPER_Z0, PAPER_DZ0], reference_turns=1, steps=steps)
+    assert v.regime == "undecided" and v.steps == steps
+    assert said in v.reason and "when the step was halved" in v.reason
+
+
+@pytest.mark.parametrize("kw, name", [({"steps": 0}, "steps"), ({"steps": 2.0}, "steps"),
+                                      ({"steps": 8, "max_steps": 8}, "max_steps"),
+                                      ({"steps": 8, "max_steps": 2 * checks.MAX_STEPS}, "max_steps"),
+                                      ({"steps": 8, "transient": 0}, "transient"),
+                                      ({"steps": 8, "period": -1.0}, "period")])
+def test_halved_verdict_refuses_bad_arguments_before_any_integration(kw, name):
+    args = dict(rates=lambda t, s: pytest.fail("integrated"), period=1.0, s0=np.zeros(6))
+    args.update(kw)
+    with pytest.raises((TypeError, ValueError), match=name):
+        halved_verdict(args.pop("rates"), args.pop("period"), args.pop("s0"), **args)
 
 
 def test_options_are_documented_defaults():

@@ -17,7 +17,8 @@ for the paper's law.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, replace
 from typing import Callable
 
 import numpy as np
@@ -28,8 +29,10 @@ from ..dynamics.sampled import sampled_extremes
 from ..integrators.batch import RK4, fixed_steps, integrate, nonfinite_message
 from ..integrators.smooth import Integration, SimulationError
 from ..machinery import checks
+from .verdict import MULTIPLIER_TOL, ORBIT_SHIFT_TOL
 
-__all__ = ["FlowMap", "LoopVerdict", "loop_verdict", "run_periods", "steady_measures", "LOOP_OPTIONS"]
+__all__ = ["FlowMap", "LoopVerdict", "loop_verdict", "halved_verdict", "run_periods", "steady_measures",
+           "LOOP_OPTIONS"]
 
 Rates = Callable[[float, np.ndarray], np.ndarray]
 
@@ -141,7 +144,11 @@ class LoopVerdict:
     gains on the path's per ``period`` periods of the orbit); ``orbit`` (d,) the orbit's state at t = 0 (NaN without one); ``multipliers``
     (d,) its Floquet multipliers; ``floquet`` the largest modulus; ``distance`` of the run's last
     section state from the orbit (state units); ``reason`` why no orbit, where there is none;
-    ``section`` (L, d) the run's section states (t = j T)."""
+    ``section`` (L, d) the run's section states (t = j T). From :func:`halved_verdict` (on the
+    finer of two RK4 maps): ``steps`` the coarser map's fixed steps a period (the finer has
+    twice as many; 0 from :func:`loop_verdict` alone), ``orbit_shift`` how far the orbit moved
+    between them (max-norm, state units, heading modulo 2 pi; NaN without an orbit on both) and
+    ``floquet_change`` how far the largest |multiplier| moved."""
 
     regime: str
     period: int
@@ -152,6 +159,9 @@ class LoopVerdict:
     distance: float
     reason: str
     section: np.ndarray
+    steps: int = 0
+    orbit_shift: float = math.nan
+    floquet_change: float = math.nan
 
 
 def run_periods(flow: FlowMap, s0, n_periods: int, *, samples: int = 0, record: int = 1):
@@ -260,6 +270,94 @@ def loop_verdict(rates: Rates, period: float, s0, *, reference_turns: int = 0, p
     regime = str(dv.orbit_regime(np.array([n]))[0])
     return LoopVerdict(regime, k, n, orb["x"][0], orb["mult"][0], float(np.abs(orb["mult"][0]).max()),
                        float(orb["distance"][0]), "", sec)
+
+
+def _orbit_shift(flow: FlowMap, a: LoopVerdict, b: LoopVerdict) -> float:
+    """How far a's orbit point lies from the nearest point of b's cycle (b.period points on
+    ``flow``, b's map): max-norm, state units, the heading (column ``flow.turn_axis``) modulo
+    2 pi; NaN unless both have an orbit."""
+    if not (np.isfinite(a.orbit).all() and np.isfinite(b.orbit).all()):
+        return math.nan
+    pts = [b.orbit]
+    for _ in range(1, b.period):
+        pts.append(flow.end(pts[-1][None])[0])
+    diff = a.orbit - np.array(pts)
+    diff[:, flow.turn_axis] = np.remainder(diff[:, flow.turn_axis] + np.pi, 2 * np.pi) - np.pi
+    return float(np.abs(diff).max(axis=1).min())
+
+
+def _disagreement(a: LoopVerdict, b: LoopVerdict, shift: float, change: float, steps: int) -> str:
+    """Why the verdicts a (``steps`` RK4 steps a period) and b (twice as many) do not make one
+    verdict, or "" when they do."""
+    when = f"when the step was halved from {steps} to {2 * steps} RK4 steps a period"
+    if (a.regime, a.period, a.turns) != (b.regime, b.period, b.turns):
+        said = [f"{v.regime} (period {v.period}, {v.turns} turns)" if v.period else f"{v.regime} ({v.reason})"
+                for v in (a, b)]
+        return f"the verdict changed {when}: {said[0]}, then {said[1]}"
+    if shift > ORBIT_SHIFT_TOL:
+        return f"the orbit moved by {shift:.3g} (more than {ORBIT_SHIFT_TOL:g}) {when}"
+    if change > MULTIPLIER_TOL:
+        return f"|mu_1| moved by {change:.3g} (more than {MULTIPLIER_TOL:g}) {when}"
+    return ""
+
+
+def halved_verdict(rates: Rates, period: float, s0, *, steps: int, max_steps: int | None = None,
+                   reference_turns: int = 0, period_end: Callable | None = None, **options) -> LoopVerdict:
+    """:func:`loop_verdict` taken on two classical RK4 maps, ``steps`` and twice as many fixed
+    steps a period, the steps doubled while the two disagree, up to ``max_steps`` for the finer.
+
+    The two agree when they give the same regime, period and turns and, where they find an
+    orbit, the orbit moves by at most :data:`lib.optimal.verdict.ORBIT_SHIFT_TOL` (max-norm,
+    state units; to the nearest point of the finer map's cycle, the heading modulo 2 pi) and its
+    largest |Floquet multiplier| by at most :data:`lib.optimal.verdict.MULTIPLIER_TOL`, the
+    tolerances of the optimal tracker's verdict. For a method of order p the finer map's error is
+    about the shift / (2^p - 1): the shift itself where RK4 keeps only p = 1 across the kinks and
+    the chattering of a clipped input (Chapter 8's loops: the shift halves with the step), a
+    fifteenth of it on a smooth field. A distance measured along the finer map's orbit is then
+    good to about 1e-4 m, below the last of three significant digits of distances of 0.1 m and
+    more, and the reach test, which measures each run against its own map's orbit, is not moved
+    by the step. Where the last pair tried still disagrees the verdict is ``undecided``, its
+    reason saying what changed when the step was halved. The result is the finer map's verdict,
+    with ``steps`` (the coarser map's), ``orbit_shift`` and ``floquet_change``.
+
+    Parameters
+    ----------
+    rates, period, s0, reference_turns, period_end, **options
+        As in :func:`loop_verdict` (not ``steps``).
+    steps : int
+        The coarser map's fixed steps a period at first, >= 1.
+    max_steps : int, optional
+        The most steps a period of the finer map, >= 2 ``steps`` and at most
+        :data:`lib.machinery.domain.MAX_STEPS` (default 2 ``steps``: one pair, no doubling).
+
+    Returns
+    -------
+    LoopVerdict
+    """
+    steps = checks.integer("steps", steps, minimum=1)
+    max_steps = checks.integer("max_steps", 2 * steps if max_steps is None else max_steps, minimum=2 * steps)
+    if max_steps > checks.MAX_STEPS:
+        raise ValueError(f"max_steps must be at most {checks.MAX_STEPS} fixed steps a period, got {max_steps}")
+
+    def verdict(n):
+        return loop_verdict(rates, period, s0, reference_turns=reference_turns, period_end=period_end,
+                            steps=n, **options)
+
+    coarse = verdict(steps)
+    while True:
+        fine = verdict(2 * steps)
+        flow = FlowMap(rates, period, steps=2 * steps, period_end=period_end)
+        try:
+            shift = _orbit_shift(flow, coarse, fine)
+        except SimulationError:
+            shift = math.inf
+        change = abs(coarse.floquet - fine.floquet) if fine.regime != "undecided" else math.nan
+        reason = _disagreement(coarse, fine, shift, change, steps)
+        if not reason or 4 * steps > max_steps:
+            break
+        coarse, steps = fine, 2 * steps
+    return replace(fine, regime="undecided" if reason else fine.regime, reason=reason or fine.reason,
+                   steps=steps, orbit_shift=shift, floquet_change=change)
 
 
 def steady_measures(t, states, F, beta, path_z, *, F_cap: float | None = None,
