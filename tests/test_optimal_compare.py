@@ -16,6 +16,7 @@ from lib.optimal.bound import cap_bound
 from lib.optimal.loop import BLOWUP, FlowMap
 from lib.optimal.motion import held_force_motion
 from lib.optimal.tracker import periodic_lqr, track_motion
+from lib.optimal.verdict import ORBIT_SHIFT_TOL
 from lib.params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from lib.tracking.runs import force_cap_sweep
 
@@ -102,6 +103,15 @@ def test_paper_rows_names_a_horizon_it_cannot_measure(kw, match):
 def test_law_row_names_a_law_it_does_not_decide():
     with pytest.raises(ValueError, match="law"):
         compare.law_row(BODY, GAINS, trajectories.eight(), "paper", Limits(4.0))
+
+
+def test_the_weighted_law_under_the_cap_is_periodic_on_two_maps_whose_orbits_agree():
+    # the orbit moves by 1.8e-4 from 128 to 256 steps a period and by 9e-5 from 256 to 512
+    # (measured): the steps are doubled once and the row says so
+    row = compare.law_row(BODY, GAINS, trajectories.eight(2.0, math.pi / 4), "weighted", Limits(4.0))
+    assert row["regime"] == "periodic" and row["reason"] == ""
+    assert compare.LAW_STEPS["weighted"] <= row["steps"] <= compare.LAW_MAX_STEPS["weighted"] // 2
+    assert row["orbit_shift"] <= ORBIT_SHIFT_TOL and row["floquet"] < 1.0
 
 
 def _rows():

@@ -4,10 +4,10 @@
 At each limit setting (:data:`lib.optimal.study.SETTINGS`) four controllers run from the paper's
 start on the eight: the paper's law (23), (25)-(26); the weighted law of Chapter 6 (the exact
 limited allocation, weights (1, 1, 1)); the law for P of Chapter 7 with its anti-windup; and the
-periodic LQR about the best periodic motion found (:mod:`lib.optimal.tracker`). The first three
-are decided by :func:`lib.optimal.loop.loop_verdict` (the book's orbit procedure), the last by
-:func:`lib.optimal.verdict.motion_verdict`; Chapter 4's verdicts for the paper's law (which also
-decide chaos) are set beside them by the chapter. Each is measured over one period of its orbit,
+periodic LQR about the best periodic motion found (:mod:`lib.optimal.tracker`). The paper's law
+is decided by Chapter 4's procedure (which also decides chaos), the next two by the book's orbit
+procedure on two RK4 maps, h and h / 2 (:func:`lib.optimal.loop.halved_verdict`), the last by
+:func:`lib.optimal.verdict.motion_verdict`. Each is measured over one period of its orbit,
 or, without one, over the last ``measure_periods`` periods of its run (a horizon's statistics).
 """
 
@@ -38,14 +38,14 @@ from ..percussion.full_loop import _limited_args, _rows_field, limited_field
 from ..percussion.law import ANTI_WINDUP_TIME, closed_loop_rates, error_polynomial
 from ..trajectories import POSITIONS, heading_turns, make
 from .bound import cap_bound
-from .loop import FlowMap, loop_verdict, run_periods, steady_measures
+from .loop import FlowMap, halved_verdict, run_periods, steady_measures
 from .study import PAPER_CAP, SETTINGS, cap_alone_chain, limit_motions, setting_label
 from .tracker import periodic_lqr, track_motion
 from .verdict import basin, motion_verdict
 
 __all__ = ["LAWS", "LawLoop", "law_loop", "law_row", "paper_rows", "side_by_side", "WEIGHTS", "THRUST0",
-           "LAW_OPTIONS", "LAW_STEPS", "PAPER_HORIZON", "PAPER_MEASURED", "RMS_BLOCK", "limits_study", "LAW_NAMES",
-           "error_table", "regime_table", "tracker_table"]
+           "LAW_OPTIONS", "LAW_STEPS", "LAW_MAX_STEPS", "PAPER_HORIZON", "PAPER_MEASURED", "RMS_BLOCK",
+           "limits_study", "LAW_NAMES", "error_table", "regime_table", "tracker_table"]
 
 #: periods the paper's law runs from the paper's start where it reaches no orbit (:func:`paper_rows`)
 PAPER_HORIZON = 120
@@ -189,16 +189,21 @@ def _measure(flow: FlowMap, loop: LawLoop, x, n_periods: int, ref, limits: Limit
 
 #: the verdict's options for the weighted law and the law for P; classical RK4 with fixed steps
 #: a period (the batch integrator of Chapter 6, whose cost stays bounded where a clipped angle
-#: chatters; 128 for the weighted law, 256 for the law for P, whose clipped angle chatters at
-#: its integrator's fastest rates), 16 periods of transient and 8 searched for an orbit
+#: chatters), 16 periods of transient and 8 searched for an orbit; each verdict taken on two maps,
+#: LAW_STEPS and twice as many steps, doubled while they disagree up to LAW_MAX_STEPS for the finer
+#: (:func:`lib.optimal.loop.halved_verdict`; the law for P's clipped angle chatters at its
+#: integrator's fastest rates, its compiled steps cheap)
 LAW_OPTIONS = dict(transient=16, history=8)
 LAW_STEPS = {"weighted": 128, "percussion": 256}
+LAW_MAX_STEPS = {"weighted": 1024, "percussion": 8192}
 
 
 def law_row(body: Body, gains: Gains, ref, law: str, limits: Limits, *, measure_periods: int = 4) -> dict:
     """The weighted law's or the law for P's verdict and measures under ``limits``: the orbit
-    procedure (:func:`lib.optimal.loop.loop_verdict`, :data:`LAW_OPTIONS`) from the paper's start,
-    then one period of the orbit, or, without one, ``measure_periods`` periods from the last state.
+    procedure (:data:`LAW_OPTIONS`) from the paper's start on two RK4 maps, step h and h / 2, that
+    must agree (:func:`lib.optimal.loop.halved_verdict`, :data:`LAW_STEPS`, :data:`LAW_MAX_STEPS`),
+    then on the finer map one period of the orbit, or, without one, ``measure_periods`` periods
+    from the last state.
 
     Parameters
     ----------
@@ -216,20 +221,22 @@ def law_row(body: Body, gains: Gains, ref, law: str, limits: Limits, *, measure_
     Returns
     -------
     dict
-        regime, reason, floquet, and the measures of :func:`lib.optimal.loop.steady_measures`.
+        regime, reason, floquet, steps (the coarser map's a period), orbit_shift (state units)
+        and the measures of :func:`lib.optimal.loop.steady_measures`.
     """
     checks.one_of("law", law, LAWS[1:3])
     loop = law_loop(body, gains, ref, law, limits)
-    v = loop_verdict(loop.rates, ref.period, loop.s0, reference_turns=heading_turns(ref), steps=LAW_STEPS[law],
-                     period_end=loop.period_end, **LAW_OPTIONS)
-    if v.reason.startswith("diverged"):
-        return dict(regime="undecided", reason=v.reason, floquet=np.nan, max_error=np.inf, rms_error=np.inf,
-                    F_peak=np.nan, beta_peak=np.nan, p_range=np.nan)
-    flow = FlowMap(loop.rates, ref.period, steps=LAW_STEPS[law], period_end=loop.period_end)
-    found = bool(np.isfinite(v.orbit).all())
+    v = halved_verdict(loop.rates, ref.period, loop.s0, reference_turns=heading_turns(ref), steps=LAW_STEPS[law],
+                       max_steps=LAW_MAX_STEPS[law], period_end=loop.period_end, **LAW_OPTIONS)
+    how = dict(regime=v.regime, reason=v.reason, floquet=v.floquet, steps=v.steps, orbit_shift=v.orbit_shift)
+    if not len(v.section):
+        return dict(how, floquet=np.nan, max_error=np.inf, rms_error=np.inf, F_peak=np.nan, beta_peak=np.nan,
+                    p_range=np.nan)
+    flow = FlowMap(loop.rates, ref.period, steps=2 * v.steps, period_end=loop.period_end)
+    found = v.regime != "undecided"
     meas = _measure(flow, loop, v.orbit if found else v.section[-1], v.period if found else measure_periods,
                     ref, limits)
-    return dict(regime=v.regime, reason=v.reason, floquet=v.floquet, **meas)
+    return dict(how, **meas)
 
 
 def paper_rows(body: Body, gains: Gains, ref, settings=SETTINGS, *, horizon: int = PAPER_HORIZON,
