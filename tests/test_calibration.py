@@ -10,6 +10,9 @@ import pytest
 from lib.dynamics import calibration as cal
 from lib.dynamics import statistics as st
 from lib.params import Body, Gains
+from lib.rotation.engine import verdict_steps
+from lib.rotation.reduced import _initial, rotation_period_map
+from lib.rotation.verdicts import VERDICT_DEFAULTS
 
 PHI, N_SERIES, LENGTH = 0.8, 200, 4000
 
@@ -145,3 +148,37 @@ def test_the_ratio_table_has_a_row_a_setting_and_a_column_an_estimator():
     assert t.loc[0, "exponent"] == "0.97 (0.78-1.30)" and t.loc[1, "drift"] == "-"
     with pytest.raises(ValueError, match="study"):
         cal.ratio_table(study.drop(columns="lo"))
+
+
+def test_heading_variogram_is_the_variance_of_the_section_headings_on_the_period_map():
+    # the same starts run by the public period map of (32) (numpy, the same DOP853 steps): the
+    # sections agree to the scheme's rounding, so the variances agree far inside 1e-9 turns^2
+    # a chaotic point of Fig. 5 after a transient of 2 periods, too short for chaos to amplify rounding
+    R, Theta, K, lags = 2.4470, 0.7823, 8, (1, 2)
+    got = cal.heading_variogram(Body(), R, Theta, lags, K, seed=3, transient=2)
+    rng = np.random.default_rng(3)
+    p0, v0 = rng.uniform(-np.pi, np.pi, K), rng.uniform(-0.5, 0.5, K) * Theta
+    n = int(verdict_steps(Body(), "eight", [R], [Theta], VERDICT_DEFAULTS["h_verdict"])[0])
+    step = rotation_period_map(Body(), "eight", np.full(K, R), np.full(K, Theta), steps=n)
+    x = np.column_stack(_initial("eight", np.full(K, Theta), p0, v0))
+    for _ in range(2):
+        x = step(x)[0]
+    sec = []
+    for _ in range(2 * max(lags)):
+        x = step(x)[0]
+        sec.append(x[:, 0])
+    sec = np.array(sec) / (2 * np.pi)
+    want = [np.var(sec[k:] - sec[:-k]) for k in lags]
+    assert got.index.tolist() == list(lags)
+    assert min(want) > 1e-4  # reason: the starts spread, so there is a variance to compare
+    np.testing.assert_allclose(got.to_numpy(), want, rtol=1e-8, atol=0)  # accuracy: one scheme, two codes; rounding (1e-13 rad) grown over 6 periods against variances above 1e-4 turns^2
+
+
+@pytest.mark.parametrize("kwargs, name", [(dict(lags=(0, 12)), "lags"), (dict(lags=(1.5,)), "lags"),
+                                          (dict(lags=()), "lags"), (dict(starts=2), "starts"),
+                                          (dict(R=-1.0), "R"), (dict(Theta=float("nan")), "Theta"),
+                                          (dict(transient=-1), "transient")])
+def test_heading_variogram_refuses_bad_input(kwargs, name):
+    args = dict(R=2.0, Theta=1.0) | kwargs
+    with pytest.raises(ValueError, match=name):
+        cal.heading_variogram(Body(), **args)

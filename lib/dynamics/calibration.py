@@ -33,11 +33,15 @@ from scipy import stats
 from ..limits.runs import switched_runs
 from ..machinery import checks
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
-from ..rotation.verdicts import FIG5_GRID, eight_rotation_sweep
+from ..rotation.engine import _Engine, verdict_steps
+from ..rotation.field import coefficients
+from ..rotation.reduced import _initial
+from ..rotation.verdicts import FIG5_GRID, VERDICT_DEFAULTS, eight_rotation_sweep
 from ..trajectories import eight
 from .statistics import batch_means, block_statistics, drift_statistics, integrated_time
 
 __all__ = ["ensemble_ratio", "limit_ensemble", "rotation_ensemble", "calibration_study", "ratio_table", "LIMIT_DEG",
+           "heading_variogram", "VARIOGRAM_LAGS",
            "FIG5_POINTS",
            "LIMIT_STARTS", "ROTATION_STARTS", "BURN_IN", "LIMIT_PERIODS", "RMS_PERIODS", "START_SPREAD",
            "RATIO_BAND", "LEVEL", "RMS_BLOCK", "SHORT_BLOCKS"]
@@ -54,6 +58,9 @@ BURN_IN, LIMIT_PERIODS, RMS_PERIODS = 60, 120, 100
 START_SPREAD = 1e-6
 #: the band the ratio of spread to error must lie in, and the confidence level of its interval
 RATIO_BAND, LEVEL = (0.8, 1.25), 0.95
+
+#: the lags (periods) at which :func:`heading_variogram` measures the heading's displacement
+VARIOGRAM_LAGS = (1, 12, 24, 72, 144)
 
 #: blocks (periods) of the limit verdicts' exponent and drift
 _LIMIT_BLOCK = 12
@@ -206,6 +213,67 @@ def rotation_ensemble(body: Body, R: float, Theta: float, starts: int = ROTATION
     return eight_rotation_sweep(body, np.full(K, R), np.full(K, Theta), p0=p0, v0=v0)
 
 
+def heading_variogram(body: Body, R: float, Theta: float, lags=VARIOGRAM_LAGS, starts: int = ROTATION_STARTS, *,
+                      seed: int = 0, transient: int = VERDICT_DEFAULTS["transient"]) -> pd.Series:
+    """How far the heading of the reduced rotation (32) on the eight at (R (m), Theta (rad/s))
+    moves in tau periods: the variance (turns^2) of p(t + tau) - p(t) at the sections
+    (t = 0 mod T) over the random starts of :func:`rotation_ensemble` (same ``seed``) and
+    over every t from the end of the ``transient`` (periods; the verdicts' by default) on, for
+    each lag of ``lags`` (periods), each start run 2 max(lags) periods past it on the verdict map
+    (:func:`lib.rotation.engine.verdict_steps` at the verdicts' h omega). It tells the drift's
+    memory apart: a variance that grows as tau is a heading that slips at random, as the
+    batch means of :func:`lib.dynamics.statistics.drift_statistics` assume; one that stays
+    flat is a heading that oscillates without slipping, whose increments cancel; one that
+    grows faster than tau has slips that persist beyond a block.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    R : float
+        The eight's size (m), > 0.
+    Theta : float
+        Its rate (rad/s), > 0.
+    lags : sequence of int
+        Lags (periods), each >= 1.
+    starts : int
+        Starts (>= 3).
+    seed : int
+        The seed of the starts.
+    transient : int
+        Periods run before the first section (>= 0).
+
+    Returns
+    -------
+    pandas.Series
+        The variance (turns^2), indexed by the lag (periods).
+    """
+    checks.instance("body", body, Body)
+    R = checks.number("R", R, positive=True)
+    Theta = checks.number("Theta", Theta, positive=True)
+    K = checks.integer("starts", starts, minimum=3)
+    transient = checks.integer("transient", transient, minimum=0)
+    lag = np.asarray(lags)
+    if lag.ndim != 1 or lag.size == 0 or not np.issubdtype(lag.dtype, np.integer) or (lag < 1).any():
+        raise ValueError(f"lags must be positive whole numbers of periods, got {lags!r}")
+    rng = np.random.default_rng(seed)                   # the starts of rotation_ensemble
+    p0 = rng.uniform(-np.pi, np.pi, K)
+    v0 = rng.uniform(-0.5, 0.5, K) * Theta
+    RR, TT = np.full(K, R), np.full(K, Theta)
+    eng = _Engine("eight", int(verdict_steps(body, "eight", RR[:1], TT[:1], VERDICT_DEFAULTS["h_verdict"])[0]),
+                  "numba")
+    A, B, C = coefficients(body, RR, TT)
+    phi, w = _initial("eight", TT, p0, v0)
+    if transient:
+        o = eng.flow(phi, w, A, B, C, transient)
+        phi, w = o["phi"] - eng.w2pi * transient, o["w"]
+    n = 2 * int(lag.max())
+    o = eng.flow(phi, w, A, B, C, n)
+    sec = o["sec"][:, :, 0] - eng.w2pi * np.arange(1, n + 1)[:, None]          # (n, K), the eight: no winding
+    var = [float(np.var((sec[k:] - sec[:-k]) / (2 * np.pi))) for k in lag]
+    return pd.Series(var, index=pd.Index(lag, name="lag (periods)"), name="variance (turns^2)")
+
+
 def _rows(setting: str, frame: pd.DataFrame, columns, level: float) -> list:
     return [dict(setting=setting, estimator=name, **ensemble_ratio(frame[x], frame[se], level))
             for name, x, se in columns]
@@ -222,7 +290,8 @@ def calibration_study(body: Body, gains: Gains, *, limit_starts: int = LIMIT_STA
     estimator, K, mean, spread, stderr, ratio, lo, hi, and: flow ("limit" or "rotation"),
     chaotic (starts decided chaotic, of ``starts``; all of them for the limit runs, which
     are not decided) and separation (the limit runs' smallest distance between two starts
-    after the burn-in, NaN for the rotation) and tau (the median integrated autocorrelation time
+    after the burn-in, NaN for the rotation), R and Theta (the Fig. 5 point, m and rad/s; NaN for
+    the limit runs) and tau (the median integrated autocorrelation time
     of the RMS's per-period mean squares, periods; NaN for the other estimates). The rows of
     estimator :data:`SHORT_BLOCKS` are not an estimator the book uses: the RMS's error from fixed
     blocks of 2 periods, shorter than that memory, for comparison.
@@ -255,7 +324,8 @@ def calibration_study(body: Body, gains: Gains, *, limit_starts: int = LIMIT_STA
         for r in _rows(f"{deg} deg", fr, (("exponent", "lyapunov", "lyapunov_stderr"),
                                           ("drift", "drift", "drift_stderr"), ("RMS", "rms", "rms_stderr"),
                                           (SHORT_BLOCKS, "rms", "rms_stderr_short")), level):
-            rows.append(dict(r, flow="limit", chaotic=limit_starts, separation=fr.attrs["separation"],
+            rows.append(dict(r, flow="limit", chaotic=limit_starts, separation=fr.attrs["separation"], R=np.nan,
+                             Theta=np.nan,
                              tau=float(np.median(fr.rms_tau)) if r["estimator"].startswith("RMS") else np.nan))
     n = FIG5_GRID["n"]
     Rg, Tg = np.linspace(*FIG5_GRID["R"], n), np.linspace(*FIG5_GRID["Theta"], n)
@@ -265,7 +335,8 @@ def calibration_study(body: Body, gains: Gains, *, limit_starts: int = LIMIT_STA
         label = f"R = {Rg[i]:.2f} m, Theta = {Tg[j]:.2f} rad/s"
         for r in _rows(label, ch, (("exponent", "lyapunov", "lyapunov_stderr"), ("drift", "slip", "slip_stderr")),
                        level):
-            rows.append(dict(r, flow="rotation", chaotic=len(ch), separation=np.nan, tau=np.nan))
+            rows.append(dict(r, flow="rotation", chaotic=len(ch), separation=np.nan, tau=np.nan, R=Rg[i],
+                             Theta=Tg[j]))
     return pd.DataFrame(rows)
 
 
