@@ -10,8 +10,8 @@ from lib import trajectories
 from lib.allocation import Limits
 from lib.closed_loop import ClosedLoop, reference_of
 from lib.machinery import checks
-from lib.optimal.loop import (LOOP_OPTIONS, FlowMap, halved_verdict, loop_verdict, run_periods,
-                              steady_measures)
+from lib.optimal.loop import (LOOP_OPTIONS, FlowMap, LoopVerdict, _orbit_shift, halved_verdict, loop_verdict,
+                              run_periods, steady_measures)
 from lib.optimal.verdict import MULTIPLIER_TOL, ORBIT_SHIFT_TOL
 from lib.params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from lib.rotation.circle import circle_eigenvalues, circle_equilibria
@@ -125,6 +125,26 @@ def test_a_map_too_coarse_to_converge_is_undecided_because_halving_the_step_chan
     v = halved_verdict(rates, ref.period, np.r_[PAPER_Z0, PAPER_DZ0], reference_turns=1, steps=steps)
     assert v.regime == "undecided" and v.steps == steps
     assert said in v.reason and "when the step was halved" in v.reason
+
+
+def test_the_orbit_shift_is_to_the_nearest_point_of_the_cycle_with_the_heading_modulo_2pi():
+    # a rotation by pi a period in the plane of columns 0 and 1: every point is on a cycle of
+    # period 2, {x, -x}; a's point is b's second point, and a heading 2 pi apart is the same one
+    def rates(t, s):
+        out = np.zeros_like(s)
+        out[:, 0], out[:, 1] = -math.pi * s[:, 1], math.pi * s[:, 0]
+        return out
+    flow = FlowMap(rates, 1.0, steps=256)
+    x = np.array([0.3, 0.4, 1.0, 0.0, 0.0, 0.0])
+
+    def said(orbit, period):
+        return LoopVerdict("periodic", period, 0, orbit, np.zeros(6, complex), 1.0, 0.0, "", np.empty((0, 6)))
+    half_turn = x * [-1, -1, 1, 1, 1, 1]
+    shift = _orbit_shift(flow, said(half_turn + [0, 0, 2 * math.pi, 0, 0, 0], 1), said(x, 2))
+    # accuracy: RK4 over a half turn in 256 steps, pi (pi / 256)^4 / 120 x 0.5 m ~ 3e-10 (measured 2.4e-10)
+    assert shift < 1e-8
+    # exact: |-0.4 - 0.4|, one point of a period-1 orbit against one (no integration)
+    assert _orbit_shift(flow, said(half_turn, 1), said(x, 1)) == pytest.approx(0.8, abs=1e-15)
 
 
 @pytest.mark.parametrize("kw, name", [({"steps": 0}, "steps"), ({"steps": 2.0}, "steps"),
