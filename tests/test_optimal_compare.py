@@ -110,7 +110,7 @@ def test_the_weighted_law_under_the_cap_is_periodic_on_two_maps_whose_orbits_agr
     # (measured): the steps are doubled once and the row says so
     row = compare.law_row(BODY, GAINS, trajectories.eight(2.0, math.pi / 4), "weighted", Limits(4.0))
     assert row["regime"] == "periodic" and row["reason"] == ""
-    assert compare.LAW_STEPS["weighted"] <= row["steps"] <= compare.LAW_MAX_STEPS["weighted"] // 2
+    assert compare.LAW_STEPS["weighted"] <= row["steps_a_period"] <= compare.LAW_MAX_STEPS["weighted"] // 2
     assert row["orbit_shift"] <= ORBIT_SHIFT_TOL and row["floquet"] < 1.0
 
 

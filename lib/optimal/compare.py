@@ -187,12 +187,10 @@ def _measure(flow: FlowMap, loop: LawLoop, x, n_periods: int, ref, limits: Limit
                            F_cap=limits.force, beta_max=limits.angle)
 
 
-#: the verdict's options for the weighted law and the law for P; classical RK4 with fixed steps
-#: a period (the batch integrator of Chapter 6, whose cost stays bounded where a clipped angle
-#: chatters), 16 periods of transient and 8 searched for an orbit; each verdict taken on two maps,
-#: LAW_STEPS and twice as many steps, doubled while they disagree up to LAW_MAX_STEPS for the finer
-#: (:func:`lib.optimal.loop.halved_verdict`; the law for P's clipped angle chatters at its
-#: integrator's fastest rates, its compiled steps cheap)
+#: the verdict's options for the weighted law and the law for P: 16 periods of transient, 8 searched
+#: for an orbit, on two maps of classical RK4 (the batch integrator of Chapter 6, whose cost stays
+#: bounded where a clipped angle chatters), LAW_STEPS and twice as many fixed steps a period, doubled
+#: while they disagree up to LAW_MAX_STEPS for the finer (:func:`lib.optimal.loop.halved_verdict`)
 LAW_OPTIONS = dict(transient=16, history=8)
 LAW_STEPS = {"weighted": 128, "percussion": 256}
 LAW_MAX_STEPS = {"weighted": 1024, "percussion": 8192}
@@ -221,14 +219,15 @@ def law_row(body: Body, gains: Gains, ref, law: str, limits: Limits, *, measure_
     Returns
     -------
     dict
-        regime, reason, floquet, steps (the coarser map's a period), orbit_shift (state units)
+        regime, reason, floquet, steps_a_period (the coarser map's RK4 steps), orbit_shift (state units)
         and the measures of :func:`lib.optimal.loop.steady_measures`.
     """
     checks.one_of("law", law, LAWS[1:3])
     loop = law_loop(body, gains, ref, law, limits)
     v = halved_verdict(loop.rates, ref.period, loop.s0, reference_turns=heading_turns(ref), steps=LAW_STEPS[law],
                        max_steps=LAW_MAX_STEPS[law], period_end=loop.period_end, **LAW_OPTIONS)
-    how = dict(regime=v.regime, reason=v.reason, floquet=v.floquet, steps=v.steps, orbit_shift=v.orbit_shift)
+    how = dict(regime=v.regime, reason=v.reason, floquet=v.floquet, steps_a_period=v.steps,
+               orbit_shift=v.orbit_shift)
     if not len(v.section):
         return dict(how, floquet=np.nan, max_error=np.inf, rms_error=np.inf, F_peak=np.nan, beta_peak=np.nan,
                     p_range=np.nan)
