@@ -187,12 +187,12 @@ def _measure(flow: FlowMap, loop: LawLoop, x, n_periods: int, ref, limits: Limit
                            F_cap=limits.force, beta_max=limits.angle)
 
 
-#: the verdict's options for the weighted law and the law for P: 16 periods of transient, 8 searched
-#: for an orbit, on two maps of classical RK4 (the batch integrator of Chapter 6, whose cost stays
-#: bounded where a clipped angle chatters), LAW_STEPS and twice as many fixed steps a period, doubled
-#: while they disagree up to LAW_MAX_STEPS for the finer (:func:`lib.optimal.loop.halved_verdict`)
+#: the verdict's options for the weighted law and the law for P (16 periods of transient, 8 searched
+#: for an orbit), decided on two maps of classical RK4 (:func:`lib.optimal.loop.halved_verdict`)
 LAW_OPTIONS = dict(transient=16, history=8)
+#: fixed RK4 steps a period of each law's coarser map, h; the finer takes h / 2, both doubled while they disagree
 LAW_STEPS = {"weighted": 128, "percussion": 256}
+#: the most fixed RK4 steps a period of each law's finer map
 LAW_MAX_STEPS = {"weighted": 1024, "percussion": 8192}
 
 
