@@ -6,13 +6,14 @@ import math
 import numpy as np
 import pandas as pd
 import pytest
+from scipy import stats
 
 from lib.dynamics import calibration as cal
 from lib.dynamics import statistics as st
 from lib.params import Body, Gains
 from lib.rotation.engine import verdict_steps
 from lib.rotation.reduced import _initial, rotation_period_map
-from lib.rotation.verdicts import VERDICT_DEFAULTS
+from lib.rotation.verdicts import FIG5_GRID, VERDICT_DEFAULTS, eight_rotation_sweep
 
 PHI, N_SERIES, LENGTH = 0.8, 200, 4000
 
@@ -182,3 +183,54 @@ def test_heading_variogram_refuses_bad_input(kwargs, name):
     args = dict(R=2.0, Theta=1.0) | kwargs
     with pytest.raises(ValueError, match=name):
         cal.heading_variogram(Body(), **args)
+
+
+def test_move_counts_expects_the_normal_tail_and_welch_s_t_tail():
+    # two pairs beyond 3 combined errors of four; expected counts recomputed from scipy's laws
+    lam1, se1, b1 = [0.0, 0.0, 1.0, 5.0], [1.0, 1.0, 0.5, 2.0], [6, 6, 25, 6]
+    lam2, se2, b2 = [0.5, 4.5, 1.1, -4.0], [1.0, 1.0, 0.5, 1.0], [6, 6, 25, 12]
+    got = cal.move_counts(lam1, se1, b1, lam2, se2, b2)
+    v = np.square(se1) + np.square(se2)
+    dof = v ** 2 / (np.power(se1, 4) / (np.array(b1) - 1) + np.power(se2, 4) / (np.array(b2) - 1))
+    assert dof[0] == 10.0                                                # exact: equal errors, 5 + 5
+    assert (got["points"], got["moved"]) == (4, 2)                     # |z| = 0.35, 3.18, 0.14, 4.02
+    assert got["normal"] == pytest.approx(4 * 2 * stats.norm.sf(3), rel=1e-12)  # exact: one formula; rounding
+    assert got["t"] == pytest.approx(sum(2 * stats.t.sf(3, d) for d in dof), rel=1e-12)  # exact: one formula; rounding
+    assert got["t"] > got["normal"]                                    # reason: a t tail is heavier
+
+
+@pytest.mark.parametrize("bad, name", [(dict(se1=[0.0, 1.0]), "errors"), (dict(blocks2=[1, 6]), "blocks"),
+                                       (dict(lam2=[0.0]), "1-D"), (dict(lam1=[np.nan, 0.0]), "finite"),
+                                       (dict(sigmas=0.0), "sigmas")])
+def test_move_counts_refuses_bad_input(bad, name):
+    args = dict(lam1=[0.0, 1.0], se1=[1.0, 1.0], blocks1=[6, 6], lam2=[0.0, 1.0], se2=[1.0, 1.0],
+                blocks2=[6, 6]) | bad
+    with pytest.raises(ValueError, match=name):
+        cal.move_counts(**args)
+
+
+@pytest.fixture(scope="module")
+def chaotic_points():
+    n = FIG5_GRID["n"]
+    Rg, Tg = np.linspace(*FIG5_GRID["R"], n), np.linspace(*FIG5_GRID["Theta"], n)
+    R, Th = zip(*[(Rg[i], Tg[j]) for i, j in cal.FIG5_POINTS[:5]])
+    return eight_rotation_sweep(Body(), np.array(R), np.array(Th))
+
+
+def test_exponents_decided_again_on_the_same_map_do_not_move(chaotic_points):
+    assert (chaotic_points.regime == "chaotic").sum() >= 3
+    got = cal.exponent_moves(Body(), chaotic_points, steps_factor=1)
+    assert got["points"] == got["chaotic"] and got["moved"] == 0 and got["spread"] == 0.0  # exact: the same computation twice
+
+
+def test_exponents_decided_again_on_a_finer_map_are_counted(chaotic_points):
+    got = cal.exponent_moves(Body(), chaotic_points)
+    assert got["chaotic"] == (chaotic_points.regime == "chaotic").sum() and 2 <= got["points"] <= got["chaotic"]
+    assert 0 <= got["moved"] <= got["points"] and got["spread"] > 0       # reason: another trajectory, another exponent
+
+
+def test_exponent_moves_refuses_a_frame_without_the_map_s_columns(chaotic_points):
+    with pytest.raises(ValueError, match="missing columns"):
+        cal.exponent_moves(Body(), chaotic_points.drop(columns=["orbit_p"]))
+    with pytest.raises(ValueError, match="steps_factor"):
+        cal.exponent_moves(Body(), chaotic_points, steps_factor=0)

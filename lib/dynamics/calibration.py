@@ -35,13 +35,14 @@ from ..machinery import checks
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from ..rotation.engine import _Engine, verdict_steps
 from ..rotation.field import coefficients
+from ..rotation.fig5 import _redo
 from ..rotation.reduced import _initial
-from ..rotation.verdicts import FIG5_GRID, VERDICT_DEFAULTS, eight_rotation_sweep
+from ..rotation.verdicts import FIG5_GRID, VERDICT_DEFAULTS, _verdict_options, eight_rotation_sweep
 from ..trajectories import eight
 from .statistics import batch_means, block_statistics, drift_statistics, integrated_time
 
 __all__ = ["ensemble_ratio", "limit_ensemble", "rotation_ensemble", "calibration_study", "ratio_table", "LIMIT_DEG",
-           "heading_variogram", "VARIOGRAM_LAGS",
+           "heading_variogram", "VARIOGRAM_LAGS", "move_counts", "exponent_moves",
            "FIG5_POINTS",
            "LIMIT_STARTS", "ROTATION_STARTS", "BURN_IN", "LIMIT_PERIODS", "RMS_PERIODS", "START_SPREAD",
            "RATIO_BAND", "LEVEL", "RMS_BLOCK", "SHORT_BLOCKS"]
@@ -272,6 +273,92 @@ def heading_variogram(body: Body, R: float, Theta: float, lags=VARIOGRAM_LAGS, s
     sec = o["sec"][:, :, 0] - eng.w2pi * np.arange(1, n + 1)[:, None]          # (n, K), the eight: no winding
     var = [float(np.var((sec[k:] - sec[:-k]) / (2 * np.pi))) for k in lag]
     return pd.Series(var, index=pd.Index(lag, name="lag (periods)"), name="variance (turns^2)")
+
+
+def move_counts(lam1, se1, blocks1, lam2, se2, blocks2, sigmas: float = 3.0) -> dict:
+    """How many of M pairs of estimates of one quantity, each with its batch-means error from its
+    own number of blocks, differ by more than ``sigmas`` combined errors sqrt(se1^2 + se2^2),
+    against the count expected of honest errors: under a normal law, and under the t law of
+    Welch's degrees of freedom (se1^2 + se2^2)^2 / (se1^4 / (b1 - 1) + se2^4 / (b2 - 1)), which an
+    error read from few blocks follows (its tail is heavier: at 6 blocks each, 10 degrees of
+    freedom put 1.3 % beyond 3, the normal law 0.27 %). Returns a dict: points (M), moved,
+    normal, t (the expected counts) and spread (the standard deviation of the differences in
+    combined errors, 1 for honest errors).
+
+    Parameters
+    ----------
+    lam1, se1, blocks1, lam2, se2, blocks2 : array_like
+        The two estimates (M,), their errors (M,, > 0) and their blocks (M,, >= 2).
+    sigmas : float
+        The threshold, in combined errors (> 0).
+
+    Returns
+    -------
+    dict
+        points, moved, normal, t, spread.
+    """
+    a = [np.asarray(x, dtype=float) for x in (lam1, se1, blocks1, lam2, se2, blocks2)]
+    if any(x.ndim != 1 or x.shape != a[0].shape for x in a) or a[0].size < 2:
+        raise ValueError("the six arrays must be 1-D of one length, at least 2")
+    l1, s1, b1, l2, s2, b2 = a
+    if not (np.all(np.isfinite(np.concatenate(a))) and np.all(s1 > 0) and np.all(s2 > 0)
+            and np.all(b1 >= 2) and np.all(b2 >= 2)):
+        raise ValueError("estimates must be finite, errors positive and blocks at least 2")
+    sigmas = checks.number("sigmas", sigmas, positive=True)
+    v = s1 ** 2 + s2 ** 2
+    z = (l1 - l2) / np.sqrt(v)
+    dof = v ** 2 / (s1 ** 4 / (b1 - 1) + s2 ** 4 / (b2 - 1))
+    return dict(points=int(z.size), moved=int((np.abs(z) > sigmas).sum()),
+                normal=float(z.size * 2 * stats.norm.sf(sigmas)), t=float(np.sum(2 * stats.t.sf(sigmas, dof))),
+                spread=float(z.std(ddof=1)))
+
+
+def exponent_moves(body: Body, frame: pd.DataFrame, *, steps_factor: int = 2, every: int = 1,
+                   sigmas: float = 3.0) -> dict:
+    """The exponents of a Fig. 5 map's chaotic points (every ``every``-th) decided again, from the
+    same starts, on the verdict map of ``steps_factor`` times its steps, whose rounding and
+    truncation send each run along another trajectory of the same attractor: :func:`move_counts`
+    of the pairs decided chaotic on both (blocks: the Lyapunov run's periods over the verdicts'
+    block). With ``steps_factor`` = 1 the decision is repeated bit for bit, and nothing moves.
+
+    Parameters
+    ----------
+    body : Body
+        The body of the map.
+    frame : pandas.DataFrame
+        A frame of :func:`lib.rotation.fig5.fig5_map` (or of
+        :func:`lib.rotation.verdicts.eight_rotation_sweep`) on the eight.
+    steps_factor : int
+        Steps of the second map over the first's (>= 1).
+    every : int
+        Take every ``every``-th chaotic point (>= 1).
+    sigmas : float
+        The threshold, in combined errors.
+
+    Returns
+    -------
+    dict
+        The dict of :func:`move_counts`, and ``chaotic`` (the chaotic points taken).
+    """
+    checks.instance("body", body, Body)
+    need = {"R", "Theta", "regime", "lyapunov", "lyapunov_stderr", "periods", "verdict_steps", "steps",
+            "period", "slip", "orbit_p"}
+    missing = need - set(getattr(frame, "columns", ()))
+    if missing:
+        raise ValueError(f"frame: a frame of the Fig. 5 map, missing columns {sorted(missing)}")
+    steps_factor = checks.integer("steps_factor", steps_factor, minimum=1)
+    every = checks.integer("every", every, minimum=1)
+    rows = np.flatnonzero((frame.regime == "chaotic").to_numpy())[::every]
+    if rows.size < 2:
+        raise ValueError(f"frame has {rows.size} chaotic points to take, need at least 2")
+    opts = _verdict_options({})
+    out = _redo(body, "eight", frame, rows, opts, steps_factor=steps_factor)
+    both = out["regime"] == "chaotic"
+    first = frame.iloc[rows[both]]
+    blocks = lambda periods: (np.asarray(periods) - opts["transient"]) // opts["block"]   # noqa: E731
+    res = move_counts(first.lyapunov, first.lyapunov_stderr, blocks(first.periods), out["lyapunov"][both],
+                      out["lyapunov_stderr"][both], blocks(out["periods"][both]), sigmas)
+    return dict(res, chaotic=int(rows.size))
 
 
 def _rows(setting: str, frame: pd.DataFrame, columns, level: float) -> list:
