@@ -61,7 +61,7 @@ START_SPREAD = 1e-6
 RATIO_BAND, LEVEL = (0.8, 1.25), 0.95
 
 #: the lags (periods) at which :func:`heading_variogram` measures the heading's displacement
-VARIOGRAM_LAGS = (1, 12, 24, 72, 144)
+VARIOGRAM_LAGS = (1, 12, 24, 48, 72)
 
 #: blocks (periods) of the limit verdicts' exponent and drift
 _LIMIT_BLOCK = 12
