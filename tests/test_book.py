@@ -148,7 +148,7 @@ def test_the_report_errata_and_front_page_computed_none_of_the_chapters_results(
 
 def test_pages_are_executed_longest_first_and_the_readers_of_other_pages_last():
     """``tools/preexecute.py`` executes every notebook page of ``_toc.yml`` (the front page,
-    Methods, chapters, report, errata), the report, the errata and the front page after the
+    Methods, chapters, report, errata), Methods, the report, the errata and the front page after the
     chapters whose cached results they read."""
     import sys
 
@@ -160,6 +160,8 @@ def test_pages_are_executed_longest_first_and_the_readers_of_other_pages_last():
     assert set(pages) == md
     ran = order(pages)
     assert sorted(ran) == sorted(pages) and ran[-len(LAST):] == list(LAST)
+    chapters = [i for i, p in enumerate(ran) if p.startswith("chapters/")]
+    assert ran.index("methods") > max(chapters)
 
 
 def test_kernels_run_numba_on_one_thread_only_when_the_pages_fill_the_cores(monkeypatch):

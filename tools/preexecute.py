@@ -38,6 +38,9 @@ import yaml
 ROOT = Path(__file__).resolve().parents[1]
 #: pages that read what other pages cached: started after the others
 LAST = ("errata", "report", "intro")
+#: pages that compute their own results but also read a chapter's (Methods reads Fig. 5's map, and
+#: would otherwise wait on its lock while Chapter 5 computes it, its slot idle): after the chapters
+AFTER_CHAPTERS = ("methods",)
 #: the kernels' environment: BLAS single-threaded. The book's matrices are small (2 x 2 to
 #: 6 x 6, stacks of them), so OpenBLAS's threads only spin: measured, Chapter 3's check of (24)
 #: (scipy's expm on a stack of 2 x 2 matrices) took 0.72 s of CPU with them and 0.08 s without,
@@ -52,9 +55,9 @@ LAST = ("errata", "report", "intro")
 KERNEL_ENV = {"OPENBLAS_NUM_THREADS": "1"}
 #: a page's CPU time (s), measured (the log of ``make book`` in a fresh clone, numba's kernels
 #: compiled on the way, 2026-11-28), to start the longest first (unknown pages first of all)
-COST = {"chapters/08_optimal": 86, "chapters/04_limits": 79, "chapters/05_stability": 62, "methods": 33,
+COST = {"chapters/08_optimal": 86, "chapters/04_limits": 79, "chapters/05_stability": 62,
         "chapters/03_tracking": 14, "chapters/07_percussion": 13, "chapters/06_allocation": 12,
-        "chapters/02_controllability": 8, "chapters/01_model": 3}
+        "chapters/02_controllability": 8, "chapters/01_model": 3, "methods": 23}
 
 
 def kernel_env(jobs: int, cores: int | None = None) -> dict:
@@ -169,10 +172,11 @@ def _children_cpu() -> float:
 
 
 def order(pages: list[str]) -> list[str]:
-    """Longest first (by :data:`COST`), the pages of :data:`LAST` at the end."""
-    first = [p for p in pages if p not in LAST]
+    """Longest first (by :data:`COST`), then the pages of :data:`AFTER_CHAPTERS`, the pages of
+    :data:`LAST` at the end."""
+    first = [p for p in pages if p not in LAST and p not in AFTER_CHAPTERS]
     return (sorted(first, key=lambda p: -COST.get(p, float("inf")))
-            + [p for p in LAST if p in pages])
+            + [p for p in AFTER_CHAPTERS + LAST if p in pages])
 
 
 def main(argv: list[str] | None = None) -> int:
