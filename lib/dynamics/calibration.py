@@ -208,10 +208,14 @@ def rotation_ensemble(body: Body, R: float, Theta: float, starts: int = ROTATION
     R = checks.number("R", R, positive=True)
     Theta = checks.number("Theta", Theta, positive=True)
     K = checks.integer("starts", starts, minimum=3)
-    rng = np.random.default_rng(seed)
-    p0 = rng.uniform(-np.pi, np.pi, K)
-    v0 = rng.uniform(-0.5, 0.5, K) * Theta
+    p0, v0 = _rotation_starts(K, Theta, seed)
     return eight_rotation_sweep(body, np.full(K, R), np.full(K, Theta), p0=p0, v0=v0)
+
+
+def _rotation_starts(K: int, Theta: float, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """The K random starts of :func:`rotation_ensemble`: p(0) (rad) and dp/dt(0) (rad/s)."""
+    rng = np.random.default_rng(seed)
+    return rng.uniform(-np.pi, np.pi, K), rng.uniform(-0.5, 0.5, K) * Theta
 
 
 def heading_variogram(body: Body, R: float, Theta: float, lags=VARIOGRAM_LAGS, starts: int = ROTATION_STARTS, *,
@@ -257,9 +261,7 @@ def heading_variogram(body: Body, R: float, Theta: float, lags=VARIOGRAM_LAGS, s
     lag = np.asarray(lags)
     if lag.ndim != 1 or lag.size == 0 or not np.issubdtype(lag.dtype, np.integer) or (lag < 1).any():
         raise ValueError(f"lags must be positive whole numbers of periods, got {lags!r}")
-    rng = np.random.default_rng(seed)                   # the starts of rotation_ensemble
-    p0 = rng.uniform(-np.pi, np.pi, K)
-    v0 = rng.uniform(-0.5, 0.5, K) * Theta
+    p0, v0 = _rotation_starts(K, Theta, seed)
     RR, TT = np.full(K, R), np.full(K, Theta)
     eng = _Engine("eight", int(verdict_steps(body, "eight", RR[:1], TT[:1], VERDICT_DEFAULTS["h_verdict"])[0]),
                   "numba")
