@@ -863,3 +863,18 @@ def test_a_focus_returning_at_lag_four_but_not_at_lag_one_is_a_fixed_point():
     # rho is the least period's: |mu(P^4)|^(1/4) = 0.98
     assert out["rho"][0] == pytest.approx(0.98, rel=1e-12)  # accuracy: the eigensolver on a normal matrix: the floor
     np.testing.assert_allclose(out["x"][0], pm.c, rtol=0, atol=1e-12)  # accuracy: Newton on a linear map, newton_tol 1e-12
+
+
+def test_a_heading_within_one_turn_takes_its_drift_error_from_two_ends_of_a_bounded_quantity():
+    # blocks of 2 periods; row 0 stays within a turn (span 1.5 rad): its error is
+    # sqrt(2 var(q)) / (4 blocks x 2 periods) in turns; row 1 spans more than a turn and keeps
+    # the batch means of its increments; without bounded_span both keep the batch means
+    ends = np.array([[0.0, 1.0, -0.5, 0.5, 0.2], [0.0, 3.0, 6.0, 9.0, 13.0]])
+    drift, se = dv.drift_statistics(ends, 2.0, 2 * np.pi, bounded_span=2 * np.pi)
+    _, se_bm = dv.drift_statistics(ends, 2.0, 2 * np.pi)
+    np.testing.assert_allclose(drift, [0.2 / 8 / (2 * np.pi), 13.0 / 8 / (2 * np.pi)], rtol=1e-15, atol=0)  # exact: one formula on given numbers; measured 0
+    want0 = np.sqrt(2 * np.var(ends[0], ddof=1)) / (2 * np.pi * 8)
+    np.testing.assert_allclose(se, [want0, se_bm[1]], rtol=1e-15, atol=0)  # exact: one formula on given numbers; measured 0
+    assert se_bm[0] == pytest.approx(np.std(np.diff(ends[0]), ddof=1) / 2 / 2 / (2 * np.pi), rel=1e-15)  # exact: one formula on given numbers; measured 0
+    with pytest.raises(ValueError, match="bounded_span"):
+        dv.drift_statistics(ends, 2.0, 2 * np.pi, bounded_span=0.0)

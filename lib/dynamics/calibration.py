@@ -160,7 +160,7 @@ def limit_ensemble(body: Body, gains: Gains, angle_deg: float, starts: int = LIM
     lam, lam_se = block_statistics(runs.log_growth[:, :LIMIT_PERIODS], _LIMIT_BLOCK)
     t = runs.t[BURN_IN:]
     p = runs.states[:, BURN_IN:, 2] - ref.z(t)[:, 2][None]
-    drift, drift_se = drift_statistics(p[:, ::_LIMIT_BLOCK], _LIMIT_BLOCK, 2 * np.pi)
+    drift, drift_se = drift_statistics(p[:, ::_LIMIT_BLOCK], _LIMIT_BLOCK, 2 * np.pi, bounded_span=2 * np.pi)
     n = RMS_PERIODS * _RMS_SAMPLES
     rec, rt = runs.recorded[:, :n], runs.recorded_t[:n]
     d2 = np.sum((rec[..., :2] - ref.z(rt)[None, :, :2]) ** 2, axis=2).reshape(K, RMS_PERIODS, _RMS_SAMPLES).mean(axis=2)

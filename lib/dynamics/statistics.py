@@ -7,9 +7,10 @@ blocks (:func:`integrated_time`), and how a section fails to come back near itse
 
 Every standard error the book quotes, and every 3-standard-error verdict, is a batch-means
 error (:func:`batch_means`): the spread of the means of consecutive blocks, over the square
-root of their number. It is honest when the blocks are long against the series' memory,
-its integrated autocorrelation time tau_int; :func:`block_statistics` therefore makes each
-series' blocks at least :data:`BLOCK_TAUS` times its own tau_int (Sokal's automatic
+root of their number, with one exception: the drift of a heading that never moves a whole turn
+(:func:`drift_statistics`'s bounded rule). It is honest when the blocks are long against the
+series' memory, its integrated autocorrelation time tau_int; :func:`block_statistics` therefore
+makes each series' blocks at least :data:`BLOCK_TAUS` times its own tau_int (Sokal's automatic
 window), whatever shorter block a caller asks for. The Methods page shows the calibration
 (:mod:`lib.dynamics.calibration`): the spread of an estimate over independent starts against
 the mean standard error reported.
@@ -161,10 +162,19 @@ def batch_means(block_means) -> tuple[np.ndarray, np.ndarray]:
     return m.mean(axis=1), m.std(axis=1, ddof=1) / math.sqrt(m.shape[1])
 
 
-def drift_statistics(at_block_ends, periods_per_block: float, unit: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+def drift_statistics(at_block_ends, periods_per_block: float, unit: float = 1.0, *,
+                     bounded_span: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Drift per period of a quantity sampled at block ends (N, m + 1), in ``unit``
     (2 pi: turns of an angle), with the standard error of its m block increments
     (:func:`batch_means`, m >= 2). Returns (drift (N,), stderr (N,)).
+
+    Batch means takes the increments as independent. That fails for a quantity that stays
+    bounded: its increments cancel over the run, the displacement q_m - q_0 does not grow with
+    m, and batch means overstates its error about sqrt(m) times (the Methods page measures it).
+    With ``bounded_span`` (in the samples' units; 2 pi for a heading), a row whose samples
+    span less than it (a heading that never moved a whole turn) is taken as bounded, and its
+    drift's error is that of the difference of two samples far apart against the quantity's
+    memory: sqrt(2 var(q)) over the run's periods, var(q) the samples' variance.
 
     Parameters
     ----------
@@ -174,13 +184,25 @@ def drift_statistics(at_block_ends, periods_per_block: float, unit: float = 1.0)
         Periods per block.
     unit : float
         The unit of the result (2 pi: turns).
+    bounded_span : float, optional
+        A row spanning less is bounded (samples' units, > 0); None: every row by batch means.
 
     Returns
     -------
     drift, stderr : numpy.ndarray
         Per period, (N,) each.
     """
-    return batch_means(np.diff(np.asarray(at_block_ends, dtype=float), axis=1) / (unit * periods_per_block))
+    q = np.asarray(at_block_ends, dtype=float)
+    drift, se = batch_means(np.diff(q, axis=1) / (unit * periods_per_block))
+    if bounded_span is None:
+        return drift, se
+    if not bounded_span > 0:
+        raise ValueError(f"bounded_span must be positive, got {bounded_span}")
+    bounded = np.ptp(q, axis=1) < bounded_span
+    periods = (q.shape[1] - 1) * periods_per_block
+    with np.errstate(invalid="ignore"):
+        se_bounded = np.sqrt(2 * q.var(axis=1, ddof=1)) / (unit * periods)
+    return drift, np.where(bounded, se_bounded, se)
 
 
 def section_returns(sec: np.ndarray, leave: float = 0.25, angles=(0,)) -> np.ndarray:
