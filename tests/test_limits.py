@@ -497,7 +497,7 @@ def test_a_chaotic_rows_measures_are_taken_on_the_run_it_was_decided_on():
     sec = runs.states[0, o["transient"]:]
     p = sec[:, 2] - ref.z(runs.t[o["transient"]:])[:, 2]
     ends = p[::o["block"]]
-    drift, se = dv.drift_statistics(ends[None], o["block"], 2 * np.pi, bounded_span=2 * np.pi)
+    drift, se = dv.heading_drift(ends[None], o["block"])
     # accuracy: the same headings; phi_d at k T / S x S against k T, rounding of 1e2 rad
     assert row.drift == pytest.approx(drift[0], rel=0, abs=1e-12)
     assert row.drift_stderr == pytest.approx(se[0], rel=0, abs=1e-12)  # accuracy: as the drift's

@@ -878,3 +878,5 @@ def test_a_heading_within_one_turn_takes_its_drift_error_from_two_ends_of_a_boun
     assert se_bm[0] == pytest.approx(np.std(np.diff(ends[0]), ddof=1) / 2 / 2 / (2 * np.pi), rel=1e-15)  # exact: one formula on given numbers; measured 0
     with pytest.raises(ValueError, match="bounded_span"):
         dv.drift_statistics(ends, 2.0, 2 * np.pi, bounded_span=0.0)
+    got = dv.heading_drift(ends, 2.0)                  # the heading's drift: in turns, bounded at one turn
+    assert np.array_equal(got[0], drift) and np.array_equal(got[1], se)

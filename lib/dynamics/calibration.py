@@ -39,7 +39,7 @@ from ..rotation.fig5 import _redo
 from ..rotation.reduced import _initial
 from ..rotation.verdicts import FIG5_GRID, VERDICT_DEFAULTS, _verdict_options, eight_rotation_sweep
 from ..trajectories import eight
-from .statistics import batch_means, block_statistics, drift_statistics, integrated_time
+from .statistics import batch_means, block_statistics, heading_drift, integrated_time
 
 __all__ = ["ensemble_ratio", "limit_ensemble", "rotation_ensemble", "calibration_study", "ratio_table", "LIMIT_DEG",
            "heading_variogram", "VARIOGRAM_LAGS", "move_counts", "exponent_moves",
@@ -121,7 +121,7 @@ def limit_ensemble(body: Body, gains: Gains, angle_deg: float, starts: int = LIM
     Lyapunov exponent (1/s) over :data:`LIMIT_PERIODS` periods, blocks of 12
     (:func:`lib.dynamics.statistics.block_statistics`); the heading's drift (turns of
     p = phi - phi_d per period) from p at the ends of those blocks
-    (:func:`lib.dynamics.statistics.drift_statistics`); C's RMS distance from the path (m)
+    (:func:`lib.dynamics.statistics.heading_drift`); C's RMS distance from the path (m)
     over the last :data:`RMS_PERIODS` periods, from the per-period mean squares (shortest
     block 2), its error carried to the RMS by the derivative. Returns one row per start:
     lyapunov, lyapunov_stderr, drift, drift_stderr, rms, rms_stderr, and rms_stderr_short
@@ -160,7 +160,7 @@ def limit_ensemble(body: Body, gains: Gains, angle_deg: float, starts: int = LIM
     lam, lam_se = block_statistics(runs.log_growth[:, :LIMIT_PERIODS], _LIMIT_BLOCK)
     t = runs.t[BURN_IN:]
     p = runs.states[:, BURN_IN:, 2] - ref.z(t)[:, 2][None]
-    drift, drift_se = drift_statistics(p[:, ::_LIMIT_BLOCK], _LIMIT_BLOCK, 2 * np.pi, bounded_span=2 * np.pi)
+    drift, drift_se = heading_drift(p[:, ::_LIMIT_BLOCK], _LIMIT_BLOCK)
     n = RMS_PERIODS * _RMS_SAMPLES
     rec, rt = runs.recorded[:, :n], runs.recorded_t[:n]
     d2 = np.sum((rec[..., :2] - ref.z(rt)[None, :, :2]) ** 2, axis=2).reshape(K, RMS_PERIODS, _RMS_SAMPLES).mean(axis=2)

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..angles import wrap_angle
 
-__all__ = ["block_statistics", "batch_means", "drift_statistics", "integrated_time", "block_length",
+__all__ = ["block_statistics", "batch_means", "drift_statistics", "heading_drift", "integrated_time", "block_length",
            "section_returns", "BLOCK_TAUS", "SOKAL_WINDOW"]
 
 #: a block is at least this many integrated autocorrelation times long, so that the batch-means
@@ -203,6 +203,27 @@ def drift_statistics(at_block_ends, periods_per_block: float, unit: float = 1.0,
     with np.errstate(invalid="ignore"):
         se_bounded = np.sqrt(2 * q.var(axis=1, ddof=1)) / (unit * periods)
     return drift, np.where(bounded, se_bounded, se)
+
+
+def heading_drift(at_block_ends, periods_per_block: float) -> tuple[np.ndarray, np.ndarray]:
+    """The heading's drift in turns per period, with its error, from the heading (rad) at block
+    ends (N, m + 1): :func:`drift_statistics` in turns with its bounded rule at one turn (a
+    heading that never moved a whole turn takes its error from its spread). The one drift of a
+    heading the book decides "lost" by (:func:`lib.dynamics.verdicts.heading_lost`).
+
+    Parameters
+    ----------
+    at_block_ends : array_like
+        The heading (rad) at block ends (N, m + 1).
+    periods_per_block : float
+        Periods per block.
+
+    Returns
+    -------
+    drift, stderr : numpy.ndarray
+        Turns per period, (N,) each.
+    """
+    return drift_statistics(at_block_ends, periods_per_block, 2 * np.pi, bounded_span=2 * np.pi)
 
 
 def section_returns(sec: np.ndarray, leave: float = 0.25, angles=(0,)) -> np.ndarray:

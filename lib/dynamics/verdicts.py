@@ -57,10 +57,10 @@ import numpy as np
 from .orbit_search import (PeriodMap, difference_jacobian, distance_to_orbit, enclosed_orbit, lag_candidates,
                            least_period, orbit_points, reached)
 from .orbits import NewtonResult, floquet_multipliers, newton
-from .statistics import batch_means, block_statistics, drift_statistics, section_returns  # re-exported
+from .statistics import batch_means, block_statistics, drift_statistics, heading_drift, section_returns  # re-exported
 
 __all__ = ["REGIMES", "SIGMAS", "PeriodMap", "lag_candidates", "difference_jacobian", "newton", "NewtonResult", "least_period",
-           "distance_to_orbit", "reached", "block_statistics", "batch_means", "drift_statistics", "section_returns", "classify",
+           "distance_to_orbit", "reached", "block_statistics", "batch_means", "drift_statistics", "heading_drift", "section_returns", "classify",
            "heading_lost", "turns_round", "held", "TRANSIENT", "needs_confirmation", "attractor_determined", "redecide_undecided", "orbit_regime", "orbit_points", "find_orbits", "enclosed_orbit"]
 
 #: the verdicts, in the order the book lists them

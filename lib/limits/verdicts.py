@@ -303,8 +303,7 @@ def _over_the_run(pmap: "_SwitchedMap", start, orb: dict, periods: int, block: i
         if k == periods and not orb["found"][rows[0]]:
             nb = periods // block
             ends = p[:, ::S * block][:, :nb + 1]
-            out["drift"][rows], out["drift_stderr"][rows] = dv.drift_statistics(ends, block, 2 * np.pi,
-                                                                                bounded_span=2 * np.pi)
+            out["drift"][rows], out["drift_stderr"][rows] = dv.heading_drift(ends, block)
         else:
             out["drift"][rows], out["drift_stderr"][rows] = orb["n"][rows] / orb["k"][rows], 0.0
     return out

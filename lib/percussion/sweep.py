@@ -243,7 +243,7 @@ def _lyapunov_run(eng, cA, cV, Theta, live, phi, hist, t, opts, out, orbits):
     regime, reason = dv.classify(lam, se, dv.section_returns(sec), band=opts["lyapunov_band"],
                                  return_tol=opts["return_tol"], max_period=opts["max_period"])
     out["regime"][live], out["reason"][live] = regime, reason
-    drift, dse = dv.drift_statistics(pb[ix], blk, 2 * np.pi, bounded_span=2 * np.pi)
+    drift, dse = dv.heading_drift(pb[ix], blk)
     out["slip"][live], out["slip_stderr"][live] = drift, dse
     out["range"][live] = hi[ix] - lo[ix]
     out["lost"][live] = dv.heading_lost(False, 0, drift, dse, slip_band=opts["slip_band"])

@@ -373,8 +373,7 @@ class _Batch:
             reason[ring[att]] = [f"slow spiral onto an attracting orbit inside the curve (|mu| = {m:.4f})"
                                  for m in mu[att]]
         out["regime"][g], out["reason"][g] = regime, reason
-        drift, dse = dv.drift_statistics(ly["pb"][done, :nb + 1], o["block"], 2 * np.pi,
-                                         bounded_span=2 * np.pi)
+        drift, dse = dv.heading_drift(ly["pb"][done, :nb + 1], o["block"])
         out["slip"][g], out["slip_stderr"][g] = drift, dse
         out["range"][g] = ly["hi"][done] - ly["lo"][done]
         out["lost"][g] = dv.heading_lost(False, 0, drift, dse, slip_band=o["slip_band"])

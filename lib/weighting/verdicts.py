@@ -476,7 +476,7 @@ def _decide(flow: _PeriodFlow, obs: dict, turns, o) -> dict:
     out["residual"][g], out["distance"][g] = orb["residual"][f], orb["distance"][f]
 
     lam, se = dv.block_statistics(logs, Bk)
-    drift, dse = dv.drift_statistics(hist[::Bk, :, 2].T, Bk, 2 * np.pi, bounded_span=2 * np.pi)
+    drift, dse = dv.heading_drift(hist[::Bk, :, 2].T, Bk)
     pdrift, pse = dv.drift_statistics(acc["pos"] / acc["cnt"], Bk)
     out["pos_drift"], out["pos_drift_stderr"] = pdrift, pse
     orbit = np.zeros(N, bool)
