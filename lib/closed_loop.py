@@ -26,7 +26,7 @@ import numba
 import numpy as np
 
 from .machinery import checks
-from .allocation import Allocation, Allocator, Limits, _limited_rows, _pinv_rows
+from .allocation import Allocation, Allocator, Limits, _limited_rows
 from .control import computed_torque_from
 from .model import config_accel
 from .params import Body, Gains
@@ -347,8 +347,8 @@ def limited_weighted_field(body: Body, gains: Gains, ref, limits: Limits | None 
     limits (``Allocation("limited", weights)``, the body both plant and model) on the circle or the
     eight: the path with its heading, (23), the weighted least-squares problem of
     :func:`lib.allocation.least_squares_problem` (its closed form; a row whose normal equations are
-    singular is solved by the pseudo-inverse, in numpy), the allocation under the limits by the
-    compiled ``lib.allocation._limited_rows``, and (2)-(4): to rounding
+    singular is solved by the pseudo-inverse), the allocation under the limits by the
+    compiled ``lib.allocation._limited_rows``, and (2)-(4), all in one compiled kernel: to rounding
     (``tests/test_weighting_field.py``), for Chapter 8's fixed-step loops on a few rows.
 
     Parameters
@@ -367,6 +367,18 @@ def limited_weighted_field(body: Body, gains: Gains, ref, limits: Limits | None 
     callable
         ``rates(t, Y)``: t (s) a float, Y (..., 6) the states; the rates, of Y's shape.
     """
+    args = _weighted_args(body, gains, ref, limits, weights)
+
+    def rates(t, Y):
+        Y = np.ascontiguousarray(Y, dtype=float)
+        rows = Y.reshape(-1, 6)
+        out = np.empty_like(rows)
+        _weighted_rows(float(t), rows, out, *args)
+        return out.reshape(Y.shape)
+    return rates
+
+
+def _weighted_args(body, gains, ref, limits, weights) -> tuple:  # _weighted_rows' (p, sw, R, Th, eight, fmax, bmax)
     checks.instance("body", body, Body)
     checks.instance("gains", gains, Gains)
     kind = checks.one_of("ref (its path's kind)", getattr(ref, "_kind", None), ("eight", "circle"))
@@ -376,19 +388,24 @@ def limited_weighted_field(body: Body, gains: Gains, ref, limits: Limits | None 
         raise ValueError(f"weights (w_x, w_y, w_phi) must not all be zero, got {weights!r}")
     fmax, bmax = (d if v is None else float(v) for v, d in ((limits.force, math.inf), (limits.angle, math.pi)))
     p = np.r_[body.m, body.I, body.a, body.c, body.c_phi, gains.kp, gains.kv].astype(float)
-    sw, R, Th, eight = np.sqrt(w), float(ref.R), float(ref.theta), kind == "eight"
+    return p, np.sqrt(w), float(ref.R), float(ref.theta), kind == "eight", fmax, bmax
 
-    def rates(t, Y):
-        Y = np.ascontiguousarray(Y, dtype=float)
-        rows = Y.reshape(-1, 6)
-        n = rows.shape[0]
-        u, G, r, bb, regular = np.empty((n, 2)), np.empty((n, 2, 2)), np.empty((n, 2)), np.empty(n), np.empty(n, bool)
-        A, b = np.empty((n, 3, 2)), np.empty((n, 3))
-        _problem_rows(float(t), rows, p, sw, R, Th, eight, u, G, r, bb, regular, A, b)
-        if not regular.all():                     # the minimum-norm solution there, as the numpy kernel's
-            u = np.ascontiguousarray(_pinv_rows(u, regular, A, b))
-        F, beta = _limited_rows(u, G, r, bb, fmax, bmax, 129, 5)
-        out = np.empty_like(rows)
-        _plant_rows(rows, F, beta, p, out)
-        return out.reshape(Y.shape)
-    return rates
+
+@numba.njit(cache=True)
+def _weighted_rows(t, Y, out, p, sw, R, Th, eight, fmax, bmax):  # pragma: no cover (compiled)
+    """The weighted law under limits at every row of Y (M, 6), its rates into out (M, 6): (23) and
+    its weighted least-squares problem (:func:`_problem_rows`), the minimum-norm solution A^+ b on
+    a singular row (NaN where A or b is not finite, as ``lib.allocation._pinv_rows``), the
+    allocation under the limits (``lib.allocation._limited_rows``) and (2)-(4)."""
+    n = Y.shape[0]
+    u, G, r, bb = np.empty((n, 2)), np.empty((n, 2, 2)), np.empty((n, 2)), np.empty(n)
+    regular, A, b = np.empty(n, np.bool_), np.empty((n, 3, 2)), np.empty((n, 3))
+    _problem_rows(t, Y, p, sw, R, Th, eight, u, G, r, bb, regular, A, b)
+    for q in range(n):
+        if not regular[q]:
+            if np.all(np.isfinite(A[q])) and np.all(np.isfinite(b[q])):
+                u[q] = np.linalg.pinv(A[q]) @ b[q]
+            else:
+                u[q] = np.nan
+    F, beta = _limited_rows(u, G, r, bb, fmax, bmax, 129, 5)
+    _plant_rows(Y, F, beta, p, out)

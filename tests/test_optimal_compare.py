@@ -57,20 +57,29 @@ def test_a_chaotic_row_of_the_paper_law_carries_the_standard_error_of_its_rms():
     assert abs(later - chaotic["rms_error"]) < 5 * math.sqrt(2) * se
 
 
+@pytest.mark.parametrize("law", ["percussion", "weighted"])
 @pytest.mark.parametrize("angle, cap", [(None, None), (None, 4.0), (30, None), (30, 4.0)])
-def test_the_law_for_p_compiled_period_is_the_numpy_rk4_steps(angle, cap):
-    """The law for P's compiled period (LawLoop.period_end) against FlowMap's RK4 steps of the same
-    field in numpy, on rows far enough from the path that the clip and the anti-windup act."""
+def test_a_law_s_compiled_period_is_the_numpy_rk4_steps(law, angle, cap):
+    """The law for P's and the weighted law's compiled period (LawLoop.period_end) against FlowMap's
+    RK4 steps of the same field in numpy, on rows far enough from the path that the clip (and the
+    anti-windup) act; the period's recorded steps too."""
     ref = trajectories.eight(2.0, math.pi / 4)
-    loop = compare.law_loop(BODY, GAINS, ref, "percussion", Limits(cap, None if angle is None else math.radians(angle)))
+    loop = compare.law_loop(BODY, GAINS, ref, law, Limits(cap, None if angle is None else math.radians(angle)))
     rng = np.random.default_rng(3)
-    x = loop.s0 + rng.normal(scale=[0.5, 0.5, 1.0, 0.5, 0.5, 1.0, 1.0], size=(5, 7))
+    d = loop.s0.size
+    x = loop.s0 + rng.normal(scale=[0.5, 0.5, 1.0, 0.5, 0.5, 1.0, 1.0][:d], size=(5, d))
     fast = FlowMap(loop.rates, ref.period, steps=256, period_end=loop.period_end)
     slow = FlowMap(loop.rates, ref.period, steps=256)
     a, b = fast.advance(np.zeros(5, int), x, 2), slow.advance(np.zeros(5, int), x, 2)
     # accuracy: the same stage sums in the same order on the same compiled field, to rounding over
     # 512 steps: 1e-10 relative (measured 0 here; a compiler may fuse a multiply-add elsewhere)
     np.testing.assert_allclose(a, b, rtol=1e-10, atol=1e-10)
+    (ea, ta, ya), (eb, tb, yb) = fast.one(x), slow.one(x)
+    np.testing.assert_allclose(ta, tb, rtol=1e-12, atol=1e-12)  # accuracy: k h against a running sum of h (the floor)
+    # accuracy: as above, over one period's 256 recorded steps
+    np.testing.assert_allclose(ya, yb, rtol=1e-10, atol=1e-10)
+    np.testing.assert_allclose(ea, eb, rtol=1e-10, atol=1e-10)  # accuracy: as above
+    assert ya.shape == (256, 5, d) and np.array_equal(ya[0], x)  # exact: the first record is the start
     F, _ = loop.inputs(np.zeros(5), x)
     if cap is not None:
         assert (F >= cap * (1 - 1e-12)).any()    # the cap binds at some start (exact: the clip's own value)

@@ -15,30 +15,25 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Callable
 
-import numba
 import numpy as np
 import pandas as pd
 
 from ..allocation import Allocation, Limits, allocate
-from ..closed_loop import ClosedLoop, limited_weighted_field, reference_of
+from ..closed_loop import ClosedLoop, _weighted_args, limited_weighted_field, reference_of
 from ..control import computed_torque
 from ..dynamics.statistics import block_statistics
-from ..integrators.batch import RK4
 from ..limits.runs import switched_runs
 from ..limits.verdicts import limit_verdicts
 from ..machinery import checks
-from ..machinery.cache import source_stamp
 from ..machinery.kinds import estimate, exact, lower_bound, upper_bound
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
-from ..percussion import full_loop
-from ..percussion.full_loop import _limited_args, _rows_field, limited_field
+from ..percussion.full_loop import _limited_args, limited_field
 from ..percussion.law import ANTI_WINDUP_TIME, closed_loop_rates, error_polynomial
 from ..trajectories import POSITIONS, heading_turns, make
 from .bound import cap_bound
-from .loop import FlowMap, halved_verdict, run_periods, steady_measures
+from .loop import FlowMap, halved_verdict, rows_period_end, run_periods, steady_measures
 from .study import PAPER_CAP, SETTINGS, cap_alone_chain, limit_motions, setting_label
 from .tracker import periodic_lqr, track_motion
 from .verdict import basin, motion_verdict
@@ -76,62 +71,6 @@ class LawLoop:
     period_end: Callable | None = None
 
 
-def _make_rows_steps(stamp: int):
-    """The kernel of :func:`_percussion_period_end`, cached on disk by numba; it closes over
-    ``stamp``, the hash of ``lib/percussion/full_loop.py`` whose field it calls (numba keys a
-    cached kernel on its own file only)."""
-
-    @numba.njit(cache=True)
-    def run(Y, n, h, hA, c, b, hb, blowup, R, Th, p, q, fc, ac, taw, circle):
-        """n steps of h (s) of the explicit tableau (hA = h A, c, b, hb = h / b_den) from t = 0 on
-        every row of Y (M, 7), in place, with the stage sums of :func:`lib.integrators.batch.steps`
-        in their order (zero coefficients skipped). Returns (0, 0, 0), or (1, t, row) where a
-        stage's state exceeds ``blowup`` in magnitude, or (2, t, row) where a step ends non-finite."""
-        M, S = Y.shape[0], c.size
-        K = np.empty((S, M, 7))
-        yi = np.empty((M, 7))
-        for k in range(n if stamp >= 0 else 0):
-            t = k * h
-            for i in range(S):
-                for r in range(M):
-                    for col in range(7):
-                        v = Y[r, col]
-                        for j in range(i):
-                            if hA[i, j] != 0:
-                                v = v + hA[i, j] * K[j, r, col]
-                        if abs(v) > blowup:
-                            return 1, t + c[i] * h, r
-                        yi[r, col] = v
-                _rows_field(t + c[i] * h, yi, K[i], R, Th, p, q, fc, ac, taw, circle)
-            for r in range(M):
-                for col in range(7):
-                    acc = b[0] * K[0, r, col]
-                    for j in range(1, S):
-                        if b[j] != 0:
-                            acc = acc + b[j] * K[j, r, col]
-                    Y[r, col] = Y[r, col] + hb * acc
-                    if not np.isfinite(Y[r, col]):
-                        return 2, (k + 1) * h, r
-        return 0, 0.0, 0
-    return run
-
-
-_rows_steps = _make_rows_steps(source_stamp(Path(full_loop.__file__)))
-
-
-def _percussion_period_end(body: Body, gains: Gains, ref, limits: Limits) -> Callable:
-    """``period_end(x, n, h, blowup)`` of the law for P under ``limits``
-    (:class:`lib.optimal.loop.FlowMap`): the classical RK4 (:data:`lib.integrators.batch.RK4`)
-    compiled on the field of :func:`lib.percussion.full_loop.limited_field`."""
-    args = _limited_args(body, gains, ref, limits, ANTI_WINDUP_TIME)
-
-    def period_end(x, n, h, blowup):
-        Y = np.array(x, dtype=float, order="C").reshape(-1, 7)
-        status = _rows_steps(Y, n, h, h * RK4.A, RK4.c, RK4.b, h / RK4.b_den, blowup, *args)
-        return (Y.reshape(np.shape(x)), *status)
-    return period_end
-
-
 def law_loop(body: Body, gains: Gains, ref, law: str, limits: Limits) -> LawLoop:
     """The closed loop of ``law`` ("paper", "weighted" or "percussion") under ``limits``,
     started from the paper's start (with the thrust state :data:`THRUST0` for the law for P).
@@ -161,9 +100,10 @@ def law_loop(body: Body, gains: Gains, ref, law: str, limits: Limits) -> LawLoop
             return loop.inputs(t, s[..., :3], s[..., 3:])[1:]
         # the weighted law's fixed-step loops call the rates at one time on a few rows: its compiled
         # field, the same to rounding; the inputs, read once over a recorded run, from the loop
-        rates = limited_weighted_field(body, gains, ref, limits, WEIGHTS) if law == "weighted" else \
-            (lambda t, s: loop.rates(t, s)[0])
-        return LawLoop(rates, inputs, s0)
+        if law == "paper":
+            return LawLoop(lambda t, s: loop.rates(t, s)[0], inputs, s0)
+        return LawLoop(limited_weighted_field(body, gains, ref, limits, WEIGHTS), inputs, s0,
+                       rows_period_end("weighted", _weighted_args(body, gains, ref, limits, WEIGHTS)))
     coeffs = error_polynomial(body, gains)
     position = POSITIONS[ref._kind]
 
@@ -176,7 +116,8 @@ def law_loop(body: Body, gains: Gains, ref, law: str, limits: Limits) -> LawLoop
     # the fixed-step loops call the rates at one time on a few rows: the compiled field, the same to
     # rounding; the inputs, read once over a recorded run, from lib.percussion.law
     return LawLoop(limited_field(body, gains, ref, limits, ANTI_WINDUP_TIME), lambda t, s: both(t, s)[1:],
-                   np.r_[s0, THRUST0], _percussion_period_end(body, gains, ref, limits))
+                   np.r_[s0, THRUST0],
+                   rows_period_end("percussion", _limited_args(body, gains, ref, limits, ANTI_WINDUP_TIME)))
 
 
 def _measure(flow: FlowMap, loop: LawLoop, x, n_periods: int, ref, limits: Limits) -> dict:

@@ -19,20 +19,27 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import Callable
 
+import numba
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from .. import closed_loop
+from ..closed_loop import _weighted_rows
 from ..dynamics import verdicts as dv
 from ..dynamics.sampled import sampled_extremes
 from ..integrators.batch import RK4, fixed_steps, integrate, nonfinite_message
 from ..integrators.smooth import Integration, SimulationError
 from ..machinery import checks
+from ..machinery.cache import source_stamp
+from ..percussion import full_loop
+from ..percussion.full_loop import _rows_field
 from .verdict import MULTIPLIER_TOL, ORBIT_SHIFT_TOL
 
 __all__ = ["FlowMap", "LoopVerdict", "loop_verdict", "halved_verdict", "run_periods", "steady_measures",
-           "LOOP_OPTIONS"]
+           "LOOP_OPTIONS", "rows_period_end"]
 
 Rates = Callable[[float, np.ndarray], np.ndarray]
 
@@ -72,6 +79,86 @@ def _fixed(rates: Rates, x: np.ndarray, t0: float, t1: float, steps: int):
         raise _blew_up(err) from None
 
 
+def _make_rows_steps(stamp: int, law: int):
+    """The kernel of :func:`rows_period_end` for one compiled field (``law`` 0: the law for P's,
+    ``lib.percussion.full_loop._rows_field``; 1: the weighted law's, ``lib.closed_loop._weighted_rows``),
+    cached on disk by numba; it closes over ``stamp``, the hash of the field's file (numba keys a
+    cached kernel on its own file only), and over ``law``, whose other branch numba prunes."""
+
+    @numba.njit(cache=True)
+    def run(Y, n, h, hA, c, b, hb, blowup, rec, args):  # pragma: no cover (compiled)
+        """n steps of h (s) of the explicit tableau (hA = h A, c, b, hb = h / b_den) from t = 0 on
+        every row of Y (M, d), in place, with the stage sums of :func:`lib.integrators.batch.steps`
+        in their order (zero coefficients skipped); the state at each step's start into rec[k] for
+        k < len(rec). Returns (0, 0, 0), or (1, t, row) where a stage's state exceeds ``blowup`` in
+        magnitude, or (2, t, row) where a step ends non-finite."""
+        M, d, S = Y.shape[0], Y.shape[1], c.size
+        K = np.empty((S, M, d))
+        yi = np.empty((M, d))
+        for k in range(n if stamp >= 0 else 0):
+            t = k * h
+            if k < rec.shape[0]:
+                rec[k] = Y
+            for i in range(S):
+                for r in range(M):
+                    for col in range(d):
+                        v = Y[r, col]
+                        for j in range(i):
+                            if hA[i, j] != 0:
+                                v = v + hA[i, j] * K[j, r, col]
+                        if abs(v) > blowup:
+                            return 1, t + c[i] * h, r
+                        yi[r, col] = v
+                if law == 0:
+                    _rows_field(t + c[i] * h, yi, K[i], *args)
+                else:
+                    _weighted_rows(t + c[i] * h, yi, K[i], *args)
+            for r in range(M):
+                for col in range(d):
+                    acc = b[0] * K[0, r, col]
+                    for j in range(1, S):
+                        if b[j] != 0:
+                            acc = acc + b[j] * K[j, r, col]
+                    Y[r, col] = Y[r, col] + hb * acc
+                    if not np.isfinite(Y[r, col]):
+                        return 2, (k + 1) * h, r
+        return 0, 0.0, 0
+    return run
+
+
+_ROWS_STEPS = {"percussion": _make_rows_steps(source_stamp(Path(full_loop.__file__)), 0),
+               "weighted": _make_rows_steps(source_stamp(Path(closed_loop.__file__)), 1)}
+
+
+def rows_period_end(law: str, args: tuple) -> Callable:
+    """``period_end(x, n, h, blowup, rec=None)`` of a compiled field (:class:`FlowMap`): the
+    classical RK4 (:data:`lib.integrators.batch.RK4`) compiled on the law for P's field under
+    limits (``law`` "percussion", ``args`` those of ``lib.percussion.full_loop._rows_field``) or
+    the weighted law's (``"weighted"``, those of ``lib.closed_loop._weighted_rows``); ``rec``
+    (n, M, d), where given, receives the state at each step's start.
+
+    Parameters
+    ----------
+    law : str
+        ``"percussion"`` or ``"weighted"``.
+    args : tuple
+        The field's arguments after (t, Y, out).
+
+    Returns
+    -------
+    callable
+        (x (M, d), n, h (s), blowup, rec=None) -> (end (M, d), code, t, row).
+    """
+    kernel = _ROWS_STEPS[checks.one_of("law", law, tuple(_ROWS_STEPS))]
+
+    def period_end(x, n, h, blowup, rec=None):
+        Y = np.array(x, dtype=float, order="C").reshape(-1, np.shape(x)[-1])
+        r = np.empty((0,) + Y.shape) if rec is None else rec
+        status = kernel(Y, n, h, h * RK4.A, RK4.c, RK4.b, h / RK4.b_den, blowup, r, args)
+        return (Y.reshape(np.shape(x)), *status)
+    return period_end
+
+
 def _integrate(rates: Rates, x: np.ndarray, t0: float, t1: float, rtol: float, atol: float, dense: bool = False):
     """solve_ivp (DOP853) of all rows of x (M, d) together from t0 to t1."""
     M, d = x.shape
@@ -93,10 +180,12 @@ class FlowMap:
     """The period map of a T-periodic field: ``advance(idx, x, k)`` integrates the rows x (M, d)
     over k periods each (adaptive DOP853, all rows at once), the heading (column ``turn_axis``)
     continuous. A :class:`lib.dynamics.verdicts.PeriodMap`; one field for every row (``idx`` unused).
-    With fixed ``steps``, ``period_end(x, n, h, blowup)`` (optional) is a compiled run of the same
-    RK4 steps, n of h (s) from t = 0, used where no step is recorded (:meth:`end`): it returns the
-    end (M, d) and a status (code, t, row), code 1 where a stage's state exceeds ``blowup`` and 2
-    where a step ends non-finite (0 otherwise), which :meth:`end` raises as ``_fixed`` does."""
+    With fixed ``steps``, ``period_end(x, n, h, blowup, rec=None)`` (optional, e.g.
+    :func:`rows_period_end`) is a compiled run of the same RK4 steps, n of h (s) from t = 0, used
+    by :meth:`end` and :meth:`one` (which passes ``rec`` (n, M, d) for the states at each step's
+    start): it returns the end (M, d) and a status (code, t, row), code 1 where a stage's state
+    exceeds ``blowup`` and 2 where a step ends non-finite (0 otherwise), which both raise as
+    ``_fixed`` does."""
 
     def __init__(self, rates: Rates, period: float, *, turn_axis: int = 2, rtol: float = 1e-10,
                  atol: float = 1e-10, steps: int = 0, period_end: Callable | None = None):
@@ -116,6 +205,13 @@ class FlowMap:
         """One period from the rows x (M, d) at t = 0: the end (M, d) and, with ``samples`` > 0
         (adaptive) or always (fixed steps), the times and states at equal steps over the period
         (the end left out)."""
+        if self.steps and self.period_end is not None:
+            n, h = fixed_steps(0.0, self.period, self.period / self.steps)
+            rec = np.empty((n,) + np.shape(x))
+            y, code, t, row = self.period_end(x, n, h, BLOWUP, rec)
+            if code:
+                raise _blew_up(_beyond(t) if code == 1 else nonfinite_message(t, row))
+            return y, np.arange(n) * h, rec
         if self.steps:
             t, y = _fixed(self.rates, x, 0.0, self.period, self.steps)
             return y[-1], t[:-1], y[:-1]
@@ -249,7 +345,7 @@ def loop_verdict(rates: Rates, period: float, s0, *, reference_turns: int = 0, p
     nan = np.full(d, np.nan)
     flow = FlowMap(rates, period, rtol=o["rtol"], atol=o["atol"], steps=o["steps"], period_end=period_end)
     try:
-        sec, _, _ = run_periods(flow, s0, o["transient"] + o["history"])
+        sec, _, _ = run_periods(flow, s0, o["transient"] + o["history"], record=0)
     except SimulationError as err:
         return LoopVerdict("undecided", 0, 0, nan, nan + 0j, np.nan, np.nan, f"diverged: {err}", np.empty((0, d)))
     hist = sec[-o["history"]:, None, :]
