@@ -300,19 +300,23 @@ def test_fig5_map_row_needs_a_map_partly_lost_and_decided(monkeypatch, lost, not
     regime[:not_held] = "chaotic"
     regime[not_held - undecided:not_held] = "undecided"
     fr = pd.DataFrame({"regime": regime, "lost": np.arange(n) < lost, "turns_round": np.arange(n) < 300,
-                       "periods": 120})
+                       "periods": 120, "drift_periods": 300})
     assert _status(monkeypatch, "fig5-map", cached=_cache(fig5_map=fr)) == status
 
 
 def test_drift_tests_chance_of_calling_a_point_lost_is_students_t_over_the_longer_runs_blocks():
-    # 120 periods, 48 of transient: a Lyapunov run of 72 periods, 288 over the longer run, 24 blocks of 12
+    # a drift over 300 periods, 1200 over the longer run: 100 blocks of 12 periods in 25 batches of 48
+    # (statistics.batch_grouping), 24 degrees of freedom; a drift over 72 periods: 288, 6 batches of 48
     from scipy import stats
 
-    fr = pd.DataFrame({"regime": ["periodic", "slipping", "chaotic", "chaotic", "undecided"], "periods": 120})
+    fr = pd.DataFrame({"regime": ["periodic", "slipping", "chaotic", "chaotic", "undecided"], "periods": 120,
+                       "drift_periods": [0, 0, 300, 300, 300]})
     tested, chance = ext.lost_false_positives(fr)
     # accuracy: scipy's t tail, the same call, summed over three points (rounding only)
-    assert tested == 3 and chance == pytest.approx(3 * 2 * stats.t.sf(3.0, 23), rel=1e-12)
-    assert 0.018 < chance < 0.020          # reason: 3 x 0.0064, far above the normal tail 3 x 0.0027
+    assert tested == 3 and chance == pytest.approx(3 * 2 * stats.t.sf(3.0, 24), rel=1e-12)
+    assert 0.018 < chance < 0.020          # reason: 3 x 0.0062, far above the normal tail 3 x 0.0027
+    _, short = ext.lost_false_positives(fr.assign(drift_periods=72))
+    assert short == pytest.approx(3 * 2 * stats.t.sf(3.0, 5), rel=1e-12)  # accuracy: as above
 
 
 def test_fig5_readings_count_each_reading_from_its_own_column():

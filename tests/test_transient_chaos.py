@@ -107,14 +107,14 @@ def test_a_fig5_point_whose_attractor_the_last_bits_decide_is_transient_chaos(pe
 
 @pytest.mark.parametrize("R, Theta, lost", [
     (0.3257575757575758, 0.9287878787878788, True),    # drifts by hundreds of standard errors
-    (2.5984848484848486, 1.2070707070707072, False),   # a drift over 72 periods that 288 do not confirm
+    (2.5984848484848486, 1.2070707070707072, False),   # no drift, over 300 periods or 1200
 ])
 def test_a_heading_lost_without_an_orbit_is_tested_over_four_times_the_horizon(R, Theta, lost, perturb):
     x0 = perturb(np.zeros(2))
     f = eight_rotation_sweep(BODY, [R], [Theta], p0=x0[0], v0=x0[1])
     c = confirm_lost(BODY, "eight", f, x0=x0)
-    h = int(f.periods.iloc[0]) - VERDICT_DEFAULTS["transient"]
-    assert f.regime.iloc[0] == "chaotic"
+    h = int(f.drift_periods.iloc[0])       # the drift's run: on to 300 periods where the heading slipped
+    assert f.regime.iloc[0] == "chaotic" and h == VERDICT_DEFAULTS["drift_periods"]
     assert bool(c.lost.iloc[0]) is lost
     if f.lost.iloc[0]:                     # decided again, every block of the longer run observed
         assert c.lost_horizon.iloc[0] == LOST_FACTOR * h
@@ -125,7 +125,7 @@ def test_a_heading_lost_without_an_orbit_is_tested_over_four_times_the_horizon(R
 
 
 def test_a_slipping_orbit_is_lost_on_its_orbit_and_not_decided_again():
-    frame = pd.DataFrame(dict(R=[1.0], Theta=[1.0], regime=["slipping"], period=[1], periods=[8], lost=[True],
+    frame = pd.DataFrame(dict(R=[1.0], Theta=[1.0], regime=["slipping"], period=[1], periods=[8], drift_periods=[0], lost=[True],
                               slip=[1.0], slip_stderr=[0.0], steps=[64], verdict_steps=[32], reason=[""]))
     c = confirm_lost(BODY, "eight", frame)
     assert bool(c.lost.iloc[0]) and c.lost_horizon.iloc[0] == 0

@@ -12,6 +12,7 @@ from lib.weighting import verdicts as loop_verdicts
 from lib.rotation import verdicts as rotation_verdicts
 from lib import stability
 from lib.angles import wrap_angle
+from lib.dynamics import statistics
 from lib.rotation.circle import circle_critical_radius, circle_eigenvalues
 from lib.dynamics import verdicts as dv
 from lib.dynamics.orbits import newton_orbit
@@ -880,3 +881,42 @@ def test_a_heading_within_one_turn_takes_its_drift_error_from_two_ends_of_a_boun
         dv.drift_statistics(ends, 2.0, 2 * np.pi, bounded_span=0.0)
     got = dv.heading_drift(ends, 2.0)                  # the heading's drift: in turns, bounded at one turn
     assert np.array_equal(got[0], drift) and np.array_equal(got[1], se)
+
+
+def test_a_long_run_merges_its_blocks_into_batches_of_at_most_48_periods_and_at_least_six():
+    # blocks of 12 periods: g = min(nb // 6, 48 // 12) blocks a batch, over the last (nb // g) g
+    assert [statistics.batch_grouping(nb, 12.0) for nb in (6, 11, 12, 25, 100)] == [
+        (1, 6), (1, 11), (2, 6), (4, 6), (4, 25)]
+    assert statistics.batch_grouping(10, 96.0) == (1, 10)    # blocks already longer than 48 periods
+    assert (statistics.MIN_BATCHES, statistics.BATCH_PERIODS) == (6, 48)
+    rng = np.random.default_rng(3)
+    q = np.cumsum(np.r_[0.0, rng.normal(size=25)])[None]   # 25 blocks: 6 increments of 48 periods
+    drift, se = dv.drift_statistics(q, 12.0)
+    inc = np.diff(q[0, 1::4]) / 48.0
+    assert inc.size == 6
+    assert drift[0] == pytest.approx(inc.mean(), rel=1e-12)  # accuracy: the same sums in another order
+    assert se[0] == pytest.approx(inc.std(ddof=1) / np.sqrt(6), rel=1e-12)  # accuracy: the same sums in another order
+    short = q[:, :12]                                        # 11 blocks: no merging
+    d11, s11 = dv.drift_statistics(short, 12.0)
+    inc11 = np.diff(short[0]) / 12.0
+    assert s11[0] == pytest.approx(inc11.std(ddof=1) / np.sqrt(11), rel=1e-12)  # accuracy: the same sums in another order
+    assert d11[0] == pytest.approx(inc11.mean(), rel=1e-12)  # accuracy: the same sums in another order
+    _, s_all = dv.drift_statistics(q, 12.0, batches=25)     # asked for 25 batches: every block kept
+    assert s_all[0] == pytest.approx(np.diff(q[0]).std(ddof=1) / 12.0 / 5.0, rel=1e-12)  # accuracy: the same sums in another order
+    for bad in (1, 2.5, 0):
+        with pytest.raises(ValueError, match="batches"):
+            dv.drift_statistics(q, 12.0, batches=bad)
+    with pytest.raises(ValueError, match="at_block_ends"):
+        dv.drift_statistics(np.zeros(5), 12.0)
+    # the same merging of block means (the exponent's), and the same refusals
+    means = rng.normal(size=(2, 25))
+    mean, err = dv.batch_means(means, 4)
+    merged = means[:, 1:].reshape(2, 6, 4).mean(axis=2)
+    np.testing.assert_allclose(mean, merged.mean(axis=1), rtol=1e-12, atol=0)  # accuracy: the same sums in another order
+    np.testing.assert_allclose(err, merged.std(axis=1, ddof=1) / np.sqrt(6), rtol=1e-12, atol=0)  # accuracy: as above
+    assert np.array_equal(dv.batch_means(means, 1)[1], dv.batch_means(means)[1])  # exact: merge 1 keeps every block
+    for bad in (0, 1.5):
+        with pytest.raises(ValueError, match="merge"):
+            dv.batch_means(means, bad)
+    with pytest.raises(ValueError, match="block_periods"):
+        statistics.batch_grouping(10, 0.0)

@@ -39,7 +39,9 @@ ROOT = Path(__file__).resolve().parents[1]
 #: pages that read what other pages cached: started after the others
 LAST = ("errata", "report", "intro")
 #: pages that compute their own results but also read a chapter's (Methods reads Fig. 5's map, and
-#: would otherwise wait on its lock while Chapter 5 computes it, its slot idle): after the chapters
+#: would otherwise wait on its lock while Chapter 5 computes it, its slot idle): after the chapters.
+#: They run at the tail of the build, beside the light pages of LAST or none, so their numba kernels
+#: get every core's thread (measured 2026-11-28: Methods 40 s alone on one thread)
 AFTER_CHAPTERS = ("methods",)
 #: the kernels' environment: BLAS single-threaded. The book's matrices are small (2 x 2 to
 #: 6 x 6, stacks of them), so OpenBLAS's threads only spin: measured, Chapter 3's check of (24)
@@ -149,9 +151,9 @@ def read_page(md: Path, root: Path = ROOT):
                                        add_source_map=True, path=str(md))
 
 
-def _execute(md: str, root: str, timeout: int, allow_errors: bool):
-    """Execute one page in its folder (in a worker process); the notebook, the error's text,
-    the wall time and the kernel's CPU time (s)."""
+def _execute(md: str, root: str, timeout: int, allow_errors: bool, threads: str | None = None):
+    """Execute one page in its folder (in a worker process), its numba kernels on ``threads``
+    threads if given; the notebook, the error's text, the wall time and the kernel's CPU time (s)."""
     from jupyter_cache.executors.utils import single_nb_execution
 
     from lib.machinery.cache import PAGE_VARIABLE
@@ -159,9 +161,18 @@ def _execute(md: str, root: str, timeout: int, allow_errors: bool):
     nb = read_page(Path(md), Path(root))
     # the page's name, for lib.machinery.cache to record which page computed a shared result
     os.environ[PAGE_VARIABLE] = Path(md).relative_to(root).with_suffix("").as_posix()
+    before = os.environ.get("NUMBA_NUM_THREADS")
+    if threads is not None:                  # inherited by this page's kernel only
+        os.environ["NUMBA_NUM_THREADS"] = threads
     cpu = _children_cpu()
-    res = single_nb_execution(nb, cwd=str(Path(md).parent), timeout=timeout, allow_errors=allow_errors,
-                              meta_override=True)
+    try:
+        res = single_nb_execution(nb, cwd=str(Path(md).parent), timeout=timeout, allow_errors=allow_errors,
+                                  meta_override=True)
+    finally:
+        if before is None:
+            os.environ.pop("NUMBA_NUM_THREADS", None)
+        else:
+            os.environ["NUMBA_NUM_THREADS"] = before
     # the kernel, a child of this worker, has ended and been waited for: its CPU time
     return nb, (res.exc_string if res.err is not None else None), res.time, _children_cpu() - cpu
 
@@ -194,6 +205,7 @@ def main(argv: list[str] | None = None) -> int:
     from jupyter_cache.base import CacheBundleIn
 
     root = args.root.resolve()
+    before = dict(os.environ)                             # what the user set
     os.environ.update(kernel_env(args.jobs))              # inherited by the workers' kernels
     execute = _config(root).get("execute", {})
     path = root / execute.get("cache", "_build/.jupyter_cache")
@@ -212,7 +224,9 @@ def main(argv: list[str] | None = None) -> int:
     tic, failed = time.perf_counter(), []
     # spawned workers: a fork after numba's threads have run aborts (lib.machinery.parallel)
     with ProcessPoolExecutor(args.jobs, mp_context=get_context("spawn")) as pool:
-        jobs = {pool.submit(_execute, str(root / f"{p}.md"), str(root), timeout, allow): p for p in pages}
+        tail = str(os.cpu_count() or 1) if "NUMBA_NUM_THREADS" not in before else None
+        jobs = {pool.submit(_execute, str(root / f"{p}.md"), str(root), timeout, allow,
+                            tail if p in AFTER_CHAPTERS else None): p for p in pages}
         for fut in as_completed(jobs):
             page = jobs[fut]
             nb, err, seconds, cpu = fut.result()

@@ -39,20 +39,21 @@ from ..rotation.fig5 import _redo
 from ..rotation.reduced import _initial
 from ..rotation.verdicts import FIG5_GRID, VERDICT_DEFAULTS, _verdict_options, eight_rotation_sweep
 from ..trajectories import eight
-from .statistics import batch_means, block_statistics, heading_drift, integrated_time
+from .statistics import batch_grouping, batch_means, block_statistics, heading_drift, integrated_time
 
 __all__ = ["ensemble_ratio", "limit_ensemble", "rotation_ensemble", "calibration_study", "ratio_table", "LIMIT_DEG",
            "heading_variogram", "VARIOGRAM_LAGS", "move_counts", "exponent_moves",
            "FIG5_POINTS",
-           "LIMIT_STARTS", "ROTATION_STARTS", "BURN_IN", "LIMIT_PERIODS", "RMS_PERIODS", "START_SPREAD",
+           "LIMIT_STARTS", "ROTATION_STARTS", "VARIOGRAM_STARTS", "BURN_IN", "LIMIT_PERIODS", "RMS_PERIODS", "START_SPREAD",
            "RATIO_BAND", "LEVEL", "RMS_BLOCK", "SHORT_BLOCKS"]
 
 #: the angle limits (deg) studied, without a cap, on Chapter 4's eight (R = 2 m, Theta = pi/4 rad/s)
 LIMIT_DEG = (30, 45)
 #: chaotic points of Fig. 5 studied, (i, j) on the n x n grid of ``FIG5_GRID``, R_i, Theta_j
 FIG5_POINTS = ((2, 26), (58, 50), (74, 58), (10, 74), (50, 82), (82, 82), (18, 90), (66, 98), (2, 98))
-#: independent starts per angle limit and per Fig. 5 point
-LIMIT_STARTS, ROTATION_STARTS = 32, 64
+#: independent starts per angle limit and per Fig. 5 point (a ratio's own spread is about 1 / sqrt(2 K),
+#: 0.044 with 256 starts, against a band of 0.8 to 1.25), and for the heading's variogram
+LIMIT_STARTS, ROTATION_STARTS, VARIOGRAM_STARTS = 32, 256, 64
 #: periods run before measuring (the limit verdicts' transient), the periods measured, the RMS's last periods
 BURN_IN, LIMIT_PERIODS, RMS_PERIODS = 60, 120, 100
 #: the limit runs' starts are the paper's state moved by this much (m, rad, m/s, rad/s) in each coordinate
@@ -60,8 +61,10 @@ START_SPREAD = 1e-6
 #: the band the ratio of spread to error must lie in, and the confidence level of its interval
 RATIO_BAND, LEVEL = (0.8, 1.25), 0.95
 
-#: the lags (periods) at which :func:`heading_variogram` measures the heading's displacement
-VARIOGRAM_LAGS = (1, 12, 24, 48, 72)
+#: the lags (periods) at which :func:`heading_variogram` measures the heading's displacement: a period,
+#: the verdicts' block, the drift's batch over a run of 300 periods, the run a chaotic point leaves after,
+#: and a longer one
+VARIOGRAM_LAGS = (1, 12, 48, 72, 144)
 
 #: blocks (periods) of the limit verdicts' exponent and drift
 _LIMIT_BLOCK = 12
@@ -218,7 +221,7 @@ def _rotation_starts(K: int, Theta: float, seed: int) -> tuple[np.ndarray, np.nd
     return rng.uniform(-np.pi, np.pi, K), rng.uniform(-0.5, 0.5, K) * Theta
 
 
-def heading_variogram(body: Body, R: float, Theta: float, lags=VARIOGRAM_LAGS, starts: int = ROTATION_STARTS, *,
+def heading_variogram(body: Body, R: float, Theta: float, lags=VARIOGRAM_LAGS, starts: int = VARIOGRAM_STARTS, *,
                       seed: int = 0, transient: int = VERDICT_DEFAULTS["transient"]) -> pd.Series:
     """How far the heading of the reduced rotation (32) on the eight at (R (m), Theta (rad/s))
     moves in tau periods: the variance (turns^2) of p(t + tau) - p(t) at the sections
@@ -320,8 +323,10 @@ def exponent_moves(body: Body, frame: pd.DataFrame, *, steps_factor: int = 2, ev
     """The exponents of a Fig. 5 map's chaotic points (every ``every``-th) decided again, from the
     same starts, on the verdict map of ``steps_factor`` times its steps, whose rounding and
     truncation send each run along another trajectory of the same attractor: :func:`move_counts`
-    of the pairs decided chaotic on both (blocks: the Lyapunov run's periods over the verdicts'
-    block). With ``steps_factor`` = 1 the decision is repeated bit for bit, and nothing moves.
+    of the pairs decided chaotic on both (blocks: the batches of each error, the Lyapunov run's
+    periods over the verdicts' block, merged as :func:`lib.dynamics.statistics.batch_means`
+    merges them). With ``steps_factor`` = 1 the decision is repeated bit for bit, and nothing
+    moves.
 
     Parameters
     ----------
@@ -353,11 +358,13 @@ def exponent_moves(body: Body, frame: pd.DataFrame, *, steps_factor: int = 2, ev
     rows = np.flatnonzero((frame.regime == "chaotic").to_numpy())[::every]
     if rows.size < 2:
         raise ValueError(f"frame has {rows.size} chaotic points to take, need at least 2")
-    opts = _verdict_options({})
+    opts = _verdict_options(dict(drift_periods=0))       # the exponent is compared: no drift run on
     out = _redo(body, "eight", frame, rows, opts, steps_factor=steps_factor)
     both = out["regime"] == "chaotic"
     first = frame.iloc[rows[both]]
-    blocks = lambda periods: (np.asarray(periods) - opts["transient"]) // opts["block"]   # noqa: E731
+    def blocks(periods):        # the batches behind each error: the blocks, merged as batch_means merges them
+        nb = (np.asarray(periods) - opts["transient"]) // opts["block"]
+        return np.array([batch_grouping(n, opts["block"])[1] for n in nb], dtype=int)
     res = move_counts(first.lyapunov, first.lyapunov_stderr, blocks(first.periods), out["lyapunov"][both],
                       out["lyapunov_stderr"][both], blocks(out["periods"][both]), sigmas)
     return dict(res, chaotic=int(rows.size))

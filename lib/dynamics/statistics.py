@@ -11,7 +11,9 @@ root of their number, with one exception: the drift of a heading that never move
 (:func:`drift_statistics`'s bounded rule). It is honest when the blocks are long against the
 series' memory, its integrated autocorrelation time tau_int; :func:`block_statistics` therefore
 makes each series' blocks at least :data:`BLOCK_TAUS` times its own tau_int (Sokal's automatic
-window), whatever shorter block a caller asks for. The Methods page shows the calibration
+window), whatever shorter block a caller asks for; :func:`drift_statistics` merges a long run's
+blocks into batches of up to :data:`BATCH_PERIODS` periods, :data:`MIN_BATCHES` of them at least
+(:func:`batch_grouping`). The Methods page shows the calibration
 (:mod:`lib.dynamics.calibration`): the spread of an estimate over independent starts against
 the mean standard error reported.
 """
@@ -25,12 +27,25 @@ import numpy as np
 from ..angles import wrap_angle
 
 __all__ = ["block_statistics", "batch_means", "drift_statistics", "heading_drift", "integrated_time", "block_length",
-           "section_returns", "BLOCK_TAUS", "SOKAL_WINDOW"]
+           "section_returns", "BLOCK_TAUS", "SOKAL_WINDOW", "MIN_BATCHES", "BATCH_PERIODS",
+           "batch_grouping"]
 
 #: a block is at least this many integrated autocorrelation times long, so that the batch-means
 #: variance of an AR(1) series is then biased low by less than 1 / BLOCK_TAUS (its standard
 #: error by less than half that), see :func:`block_length`
 BLOCK_TAUS = 6
+
+#: a long run's batch means merge consecutive blocks into longer batches (:func:`batch_grouping`), so
+#: that a longer run buys longer batches against a memory of tens of periods, rather than more
+#: blocks of the same length (the Methods page measures both); this many batches at least (B.
+#: Schmeiser, Oper. Res. 30, 1982, on the number of batches), fewer than twice as many while the
+#: batches are shorter than :data:`BATCH_PERIODS`
+MIN_BATCHES = 6
+
+#: the longest batch (periods) of :func:`batch_grouping`, since the heading's displacement variance
+#: V(tau) / tau levels off by about 48 periods at Fig. 5's slipping points (Methods), and a longer
+#: run then buys more batches, which a test at 3 standard errors needs
+BATCH_PERIODS = 48
 
 #: Sokal's automatic window c, the autocorrelations summed up to the first lag M >= c tau_int(M)
 SOKAL_WINDOW = 5.0
@@ -138,16 +153,50 @@ def block_statistics(per_period, block: int) -> tuple[np.ndarray, np.ndarray]:
     return mean, se
 
 
-def batch_means(block_means) -> tuple[np.ndarray, np.ndarray]:
-    """Mean and standard error of the means of consecutive blocks (N, nb): the standard
-    deviation of the block means over sqrt(nb) (NaN for nb = 1). The one estimator of every
-    error the book quotes; honest when the blocks are long against the series' memory
-    (:func:`block_length`).
+def batch_grouping(n_blocks: int, block_periods: float, batches: int = MIN_BATCHES,
+                   longest: float = BATCH_PERIODS) -> tuple[int, int]:
+    """How :func:`batch_means` merges a run of ``n_blocks`` blocks of ``block_periods`` periods:
+    g consecutive blocks a batch, g = nb // ``batches`` but no batch longer than ``longest``
+    periods (and g >= 1), over the last (nb // g) g blocks. Returns (g, number of batches).
+
+    Parameters
+    ----------
+    n_blocks : int
+        Blocks in the run (>= 1).
+    block_periods : float
+        Periods a block (> 0).
+    batches : int
+        The fewest batches (>= 2), :data:`MIN_BATCHES`.
+    longest : float
+        The longest batch (periods), :data:`BATCH_PERIODS`.
+
+    Returns
+    -------
+    tuple
+        (blocks a batch, batches).
+    """
+    if not batches >= 2 or int(batches) != batches:
+        raise ValueError(f"batches must be a whole number >= 2, got {batches!r}")
+    if not block_periods > 0:
+        raise ValueError(f"block_periods must be positive, got {block_periods!r}")
+    nb = int(n_blocks)
+    g = max(1, min(nb // int(batches), int(longest // block_periods)))
+    return g, nb // g
+
+
+def batch_means(block_means, merge: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """Mean and standard error of the means of consecutive blocks (N, nb) of equal length: the
+    standard deviation of the block means over sqrt(nb) (NaN for nb = 1). The one estimator of
+    every error the book quotes; honest when the blocks are long against the series' memory
+    (:func:`block_length`). With ``merge`` = g > 1 the last (nb // g) g blocks are first merged g
+    at a time into longer batches (:func:`batch_grouping` chooses g for a long run).
 
     Parameters
     ----------
     block_means : array_like
         Block means (N, nb).
+    merge : int
+        Blocks merged into one batch (>= 1).
 
     Returns
     -------
@@ -157,16 +206,29 @@ def batch_means(block_means) -> tuple[np.ndarray, np.ndarray]:
     m = np.asarray(block_means, dtype=float)
     if m.ndim != 2:
         raise ValueError(f"block_means must have shape (N, nb), got {m.shape}")
+    if not merge >= 1 or int(merge) != merge:
+        raise ValueError(f"merge must be a whole number >= 1, got {merge!r}")
+    g, nb = int(merge), m.shape[1]
+    if g > 1:
+        m = m[:, nb - (nb // g) * g:].reshape(m.shape[0], nb // g, g).mean(axis=2)
     if m.shape[1] < 2:                      # one block: no spread to read an error from
         return m.mean(axis=1), np.full(m.shape[0], np.nan)
     return m.mean(axis=1), m.std(axis=1, ddof=1) / math.sqrt(m.shape[1])
 
 
 def drift_statistics(at_block_ends, periods_per_block: float, unit: float = 1.0, *,
-                     bounded_span: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+                     bounded_span: float | None = None, batches: int = MIN_BATCHES,
+                     longest: float = BATCH_PERIODS) -> tuple[np.ndarray, np.ndarray]:
     """Drift per period of a quantity sampled at block ends (N, m + 1), in ``unit``
-    (2 pi: turns of an angle), with the standard error of its m block increments
+    (2 pi: turns of an angle), with the standard error of its block increments
     (:func:`batch_means`, m >= 2). Returns (drift (N,), stderr (N,)).
+
+    A long run merges g consecutive blocks into one increment and uses its last (m // g) g
+    blocks (:func:`batch_grouping`: at least ``batches`` increments, none longer than
+    ``longest`` periods). Batch means
+    is honest only with blocks long against the increments' memory; a heading whose slips
+    come in runs of tens of periods needs blocks that long (at Fig. 5's slipping points,
+    blocks of 12 periods understated the error by a fifth, Methods).
 
     Batch means takes the increments as independent. That fails for a quantity that stays
     bounded: its increments cancel over the run, the displacement q_m - q_0 does not grow with
@@ -186,6 +248,8 @@ def drift_statistics(at_block_ends, periods_per_block: float, unit: float = 1.0,
         The unit of the result (2 pi: turns).
     bounded_span : float, optional
         A row spanning less is bounded (samples' units, > 0); None: every row by batch means.
+    batches, longest : int, float
+        The fewest increments, and the longest (periods), of :func:`batch_grouping`.
 
     Returns
     -------
@@ -193,11 +257,16 @@ def drift_statistics(at_block_ends, periods_per_block: float, unit: float = 1.0,
         Per period, (N,) each.
     """
     q = np.asarray(at_block_ends, dtype=float)
-    drift, se = batch_means(np.diff(q, axis=1) / (unit * periods_per_block))
+    if q.ndim != 2 or q.shape[1] < 2:
+        raise ValueError(f"at_block_ends must have shape (N, m + 1) with m >= 1 blocks, got {q.shape}")
+    g, _ = batch_grouping(q.shape[1] - 1, periods_per_block, batches, longest)
+    drift, se = batch_means(np.diff(q, axis=1) / (unit * periods_per_block), g)
     if bounded_span is None:
         return drift, se
     if not bounded_span > 0:
         raise ValueError(f"bounded_span must be positive, got {bounded_span}")
+    m = q.shape[1] - 1
+    q = q[:, m - (m // g) * g:]                         # the span the merged increments cover
     bounded = np.ptp(q, axis=1) < bounded_span
     periods = (q.shape[1] - 1) * periods_per_block
     with np.errstate(invalid="ignore"):

@@ -22,6 +22,7 @@ from ..rotation.circle import circle_critical_radius
 from ..rotation.circle_global import bistable_window, torque_pendulum_threshold, window_closing_rate
 from ..limits.attractors import half_period_mirror, mirror_defect
 from ..dynamics.verdicts import ORBIT_REGIMES, SIGMAS, held
+from ..dynamics.statistics import batch_grouping
 from ..percussion import circle_lock_radius, percussion_fig5_map
 from ..percussion.claims import paper_circle_of_p
 from ..optimal import margins
@@ -88,16 +89,16 @@ def lost_false_positives(frame: pd.DataFrame) -> tuple[int, float]:
     A heading without an orbit is lost when its drift differs from zero by more than
     :data:`lib.dynamics.verdicts.SIGMAS` standard errors (plus a band) over a run of h periods,
     and again over ``LOST_FACTOR`` h (:func:`lib.rotation.fig5.confirm_lost`); the standard
-    error comes from the means of blocks of ``block`` periods. With independent, normal block
-    means and no drift, the longer run's statistic is Student's t with (blocks - 1) degrees of
-    freedom, so a point is called lost with probability at most 2 P(T > SIGMAS); summed over
+    error comes from the means of batches (:func:`lib.dynamics.statistics.batch_grouping`). With
+    independent, normal batch means and no drift, the longer run's statistic is Student's t with
+    (batches - 1) degrees of freedom, so a point is called lost with probability at most 2 P(T > SIGMAS); summed over
     the points decided by the test.
 
     Parameters
     ----------
     frame : pandas.DataFrame
         A map of :func:`lib.rotation.fig5.fig5_map` with its default options (columns
-        ``regime``, ``periods``).
+        ``regime``, ``drift_periods``).
 
     Returns
     -------
@@ -108,8 +109,9 @@ def lost_false_positives(frame: pd.DataFrame) -> tuple[int, float]:
     """
     opts = VERDICT_DEFAULTS
     no_orbit = ~frame.regime.isin(ORBIT_REGIMES).to_numpy()
-    h = frame.periods.to_numpy()[no_orbit] - opts["transient"]            # the first Lyapunov run
-    dof = np.maximum(LOST_FACTOR * h // opts["block"] - 1, 1)
+    h = frame.drift_periods.to_numpy()[no_orbit]                        # the first drift's run
+    batches = [batch_grouping(LOST_FACTOR * n // opts["block"], opts["block"])[1] for n in h]
+    dof = np.maximum(np.array(batches, dtype=int) - 1, 1)
     return int(no_orbit.sum()), float(np.sum(2 * stats.t.sf(SIGMAS, dof)))
 
 

@@ -73,7 +73,7 @@ def heading_sweep(body: Body, R, Theta, *, kind: str = "eight", p0=0.0, executor
     eight (28) by default) of size R_i (m) at Theta_i (rad/s), from p(0) = ``p0`` (rad), with
     the columns of :func:`lib.stability.eight_rotation_sweep` (R, Theta, regime, period, range,
     floquet, lyapunov, lyapunov_stderr, slip, slip_stderr, lost, orbit_p, distance, residual,
-    mirror, periods, reason, turns_round, steps, verdict_steps). ``executor``, ``chunk_size``,
+    mirror, periods, drift_periods, reason, turns_round, steps, verdict_steps). ``executor``, ``chunk_size``,
     ``progress``: as in :func:`lib.machinery.parallel.map_chunks`. ``options``: :data:`SWEEP_DEFAULTS`.
 
     Parameters
@@ -152,8 +152,8 @@ def _new_out(N):
                 floquet=np.full(N, np.nan), lyapunov=np.full(N, np.nan), lyapunov_stderr=np.full(N, np.nan),
                 slip=np.full(N, np.nan), slip_stderr=np.full(N, np.nan), lost=np.zeros(N, bool),
                 orbit_p=np.full(N, np.nan), distance=np.full(N, np.nan), residual=np.full(N, np.nan),
-                mirror=np.full(N, np.nan), periods=np.zeros(N, int), reason=np.full(N, "", dtype=object),
-                x=np.full(N, np.nan), slip_n=np.zeros(N, int))
+                mirror=np.full(N, np.nan), periods=np.zeros(N, int), drift_periods=np.zeros(N, int),
+                reason=np.full(N, "", dtype=object), x=np.full(N, np.nan), slip_n=np.zeros(N, int))
 
 
 def _frame(R, Theta, p0, *, body, kind, opts) -> pd.DataFrame:
@@ -247,7 +247,7 @@ def _lyapunov_run(eng, cA, cV, Theta, live, phi, hist, t, opts, out, orbits):
     out["slip"][live], out["slip_stderr"][live] = drift, dse
     out["range"][live] = hi[ix] - lo[ix]
     out["lost"][live] = dv.heading_lost(False, 0, drift, dse, slip_band=opts["slip_band"])
-    out["periods"][live] = t
+    out["periods"][live], out["drift_periods"][live] = t, nb_max * blk
 
 
 def _ranges(eng, cA, cV, out):

@@ -2,7 +2,8 @@
 the forcing of one reference tabulated at n steps per period, the compiled fixed-step
 8th-order Dormand-Prince flow with its exact Jacobian and renormalised tangent vector
 (:func:`lib.integrators.compiled.rotation_flow`, or the same scheme in numpy), the period
-map seen by :mod:`lib.dynamics.verdicts`, and the range of p over an orbit.
+map seen by :mod:`lib.dynamics.verdicts`, the range of p over an orbit, and each orbit the
+verdicts found located again on the fine map (``_on_fine_map``).
 
 Units: R in m, Theta in rad/s, angles in rad, the phase s = Theta t in rad; w = d phi / ds.
 """
@@ -12,6 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..angles import wrap_angle
+from ..dynamics import verdicts as dv
+from ..dynamics.orbits import floquet_multipliers
 from ..integrators import batch
 from ..integrators.compiled import rotation_flow
 from ..machinery import checks
@@ -256,3 +259,45 @@ def check_domain(body: Body, kind: str, R, Theta, h_lambda: float = 0.125) -> np
     A, _, _ = coefficients(body, R, Theta)
     checks.steps_domain(steps, 2 * np.pi * A / h_lambda, R, Theta)
     return steps
+
+
+#: Newton on the reduced rotation's period map (exact Jacobian): polished below its
+#: tolerance while the residual still halves
+_NEWTON = dict(max_iter=15, max_step=1.0, polish=1e-13)
+
+
+def _on_fine_map(body, kind, R, Theta, n_pts, n_fine, opts, engine, out) -> None:
+    """Each attracting orbit on the fine map (``n_fine`` steps per period): Newton from the
+    orbit found on the verdict map, its multipliers, and its range sampled at every step
+    (Hermite-refined extremes). An orbit that does not survive is undecided."""
+    orb = np.flatnonzero(np.isin(out["regime"], ("periodic", "slipping")))
+    for n in np.unique(n_fine[orb]):
+        eng = _Engine(kind, int(n), engine)
+        for k in np.unique(out["period"][orb]):
+            g = orb[(n_fine[orb] == n) & (out["period"][orb] == k)]
+            if g.size == 0:
+                continue
+            A, B, C = coefficients(body, R[g], Theta[g])
+            if np.any(n_pts[g] != n):
+                rmap = RotationMap(eng, A, B, C)
+                x, J, res, _, _ = dv.newton(rmap.step, np.arange(g.size), out["x"][g], int(k), turn_axis=0,
+                                         turns=out["slip_n"][g], tol=opts["newton_tol"], **_NEWTON)
+                ok = res <= opts["newton_tol"]
+                mult = np.full((g.size, 2), np.nan + 0j)
+                if ok.any():
+                    mult[ok] = floquet_multipliers(J[ok])
+                ok &= np.abs(mult[:, 0]) < 1.0
+                bad = g[~ok]
+                out["regime"][bad] = "undecided"
+                out["reason"][bad] = "the orbit of the verdict map is not an attracting orbit of the fine map"
+                out["period"][bad], out["lost"][bad] = 0, False
+                for key in ("floquet", "lyapunov", "slip", "slip_stderr", "orbit_p", "distance"):
+                    out[key][bad] = np.nan
+                g, A, B, C, x, mult, res = g[ok], A[ok], B[ok], C[ok], x[ok], mult[ok], res[ok]
+                out["x"][g], out["mult"][g], out["residual"][g] = x, mult, res
+                mod = np.abs(mult[:, 0])
+                out["floquet"][g] = mod
+                out["lyapunov"][g] = np.log(mod) * Theta[g] / (2 * np.pi * k)
+                if g.size == 0:
+                    continue
+            out["range"][g], out["mirror"][g] = orbit_range(eng, out["x"][g], A, B, C, int(k), out["slip_n"][g])

@@ -178,6 +178,7 @@ def confirm_attractors(body: Body, kind: str, frame: pd.DataFrame, confirm=("per
     out["confirmed"] = 0
     if rows.size == 0 or not confirm:
         return out
+    opts["drift_periods"] = 0                 # the regime and the orbit are compared: no drift run on
     redo = [_redo(body, kind, frame, rows, opts, start=ROBUST_REL if key == "perturbed" else 0.0,
                   steps_factor=2 if key == "steps_x2" else 1, x0=_rows(x0, frame, rows)) for key in confirm]
     first_r, first_k = frame.regime.to_numpy()[rows], frame.period.to_numpy()[rows]
@@ -199,8 +200,9 @@ def confirm_attractors(body: Body, kind: str, frame: pd.DataFrame, confirm=("per
 def confirm_lost(body: Body, kind: str, frame: pd.DataFrame, factor: int = LOST_FACTOR, *, x0=(0.0, 0.0),
                  **options) -> pd.DataFrame:
     """A copy of a frame of :func:`lib.rotation.verdicts.rotation_verdicts` whose headings lost
-    without a slipping orbit (from the reference, or from ``x0`` as in :func:`confirm_attractors`; a drift test over one Lyapunov run of h periods) are decided
-    again from the same start over a Lyapunov run of ``factor`` h periods, every block of it
+    without a slipping orbit (from the reference, or from ``x0`` as in :func:`confirm_attractors`; a drift test over
+    h periods of Lyapunov run, the frame's ``drift_periods``) are decided again from the same
+    start over a Lyapunov run of ``factor`` h periods, every block of it
     (no early stop): ``lost`` stays True only where the heading is lost again
     (:func:`lib.dynamics.verdicts.heading_lost`: a slipping orbit, or the drift more than 3
     standard errors plus the slip band from zero over the longer run); ``slip`` and
@@ -232,7 +234,7 @@ def confirm_lost(body: Body, kind: str, frame: pd.DataFrame, factor: int = LOST_
     opts = _verdict_options(options)
     out = frame.copy()
     orbit = frame.regime.isin(dv.ORBIT_REGIMES).to_numpy()
-    h = np.where(orbit, 0, frame.periods.to_numpy() - opts["transient"])
+    h = np.where(orbit, 0, frame.drift_periods.to_numpy())
     out["lost_horizon"] = h
     drift = frame.slip_stderr.to_numpy() > 0                  # lost by the drift test (0 on an orbit)
     todo = np.flatnonzero(frame.lost.to_numpy() & drift & ~orbit & (h > 0))
@@ -243,7 +245,7 @@ def confirm_lost(body: Body, kind: str, frame: pd.DataFrame, factor: int = LOST_
         idx = frame.index[rows]
         out.loc[idx, "lost"] = r["lost"]
         out.loc[idx, "slip"], out.loc[idx, "slip_stderr"] = r["slip"], r["slip_stderr"]
-        out.loc[idx, "lost_horizon"] = np.where(np.isin(r["regime"], dv.ORBIT_REGIMES), 0, r["periods"] - opts["transient"])
+        out.loc[idx, "lost_horizon"] = out.loc[idx, "drift_periods"] = r["drift_periods"]
         moved = np.isin(r["regime"], dv.ORBIT_REGIMES)
         for j in np.flatnonzero(moved):
             longer = f"{factor} x the horizon: {_describe(r['regime'][j], r['period'][j])} after {r['periods'][j]} periods"

@@ -24,11 +24,11 @@ import pandas as pd
 from ..machinery import checks
 from ..angles import wrap_angle
 from ..dynamics import verdicts as dv
-from ..dynamics.orbits import floquet_multipliers
+from ..dynamics.statistics import batch_grouping
 from ..machinery.parallel import concat_frames, map_chunks
 from ..params import Body
 from .reduced import ENGINES, check_grid, _initial
-from .engine import RotationMap, _Engine, check_domain, orbit_range, verdict_steps
+from .engine import _NEWTON, RotationMap, _Engine, _on_fine_map, check_domain, verdict_steps
 from .field import coefficients
 
 __all__ = ["REGIMES", "VERDICT_DEFAULTS", "SLOW_FLOQUET", "verdict_steps", "section_returns", "rotation_verdicts",
@@ -73,7 +73,8 @@ def _check_body_kind(body, kind):
 
 
 _DEFAULTS = dict(transient=48, min_transient=8, chunk=8, max_period=8, lyapunov_periods=300, block=12,
-                 min_lyapunov_periods=72, newton_tol=1e-10, candidate_tol=0.05, reach_tol=0.05, reach_floor=1e-9,
+                 min_lyapunov_periods=72, drift_periods=300,
+                 newton_tol=1e-10, candidate_tol=0.05, reach_tol=0.05, reach_floor=1e-9,
                  lyapunov_band=0.01, slip_band=1e-3, h_verdict=0.25, return_tol=0.05)
 
 
@@ -86,7 +87,7 @@ SLOW_FLOQUET = 0.9
 
 def _verdict_options(options: dict) -> dict:
     o = checks.options(options, _DEFAULTS, dict(transient=1, min_transient=1, chunk=1, lyapunov_periods=0,
-                                                min_lyapunov_periods=0, max_period=1, block=2),
+                                                min_lyapunov_periods=0, max_period=1, block=2, drift_periods=0),
                        extra=("max_periods",))
     mp = options.get("max_periods")
     if mp is not None:  # a total budget of periods per point: the transient first
@@ -95,6 +96,7 @@ def _verdict_options(options: dict) -> dict:
         o["min_transient"] = min(o["min_transient"], o["transient"])
         o["lyapunov_periods"] = min(o["lyapunov_periods"], mp - o["transient"])
     o["min_transient"] = min(o["min_transient"], o["transient"])
+    o["drift_periods"] = min(o["drift_periods"], o["lyapunov_periods"])
     return o
 
 
@@ -131,10 +133,17 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
        Jacobian, renormalised every period, over up to ``lyapunov_periods`` (300)
        periods; lambda (1/s) is the mean log growth per period divided by the period
        2 pi / Theta, its standard error from the means of blocks of ``block`` (12)
-       periods (batch means, so that correlated periods do not shrink it). After every
-       block from ``min_lyapunov_periods`` (72) on, a point that is not clearly
+       periods (batch means, so that correlated periods do not shrink it; a long run merges
+       them into batches of up to 48 periods, at least 6 of them, as the drift's,
+       :func:`lib.dynamics.statistics.batch_grouping`). After every block from
+       ``min_lyapunov_periods`` (72) on, a point that is not clearly
        expanding is handed to Newton again, and a clearly chaotic one (lambda T above
-       the band and 5 standard errors) stops.
+       the band and 5 standard errors) stops. If its heading has moved a whole turn, it
+       then runs on without its tangent vector, for its drift alone, to ``drift_periods``
+       (300) periods of Lyapunov run (0: no further), so that the drift's error has
+       batches long against the heading's slips, 48 periods
+       (:func:`lib.dynamics.statistics.drift_statistics`); its regime, exponent and range
+       are those decided when it stopped.
        At the end: ``chaotic`` when lambda T > max(3 SE, ``lyapunov_band``) (T the
        period, so the band is per period, 0.01); ``quasiperiodic`` when |lambda T| <=
        band, its SE <= band / 3, and the section closes on itself: the run comes back
@@ -189,8 +198,8 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
         Hermite interpolation (:func:`lib.dynamics.sampled.sampled_range`); over the Lyapunov run otherwise);
         floquet (largest multiplier modulus); lyapunov, lyapunov_stderr (1/s; for an orbit
         ln|mu_1| / (k T) with no error); slip, slip_stderr (turns of p per period: n / k on
-        an orbit, the measured drift over the Lyapunov run with its batch-means error
-        otherwise); lost (bool, :func:`lib.dynamics.verdicts.heading_lost`): the heading slips
+        an orbit, the measured drift over the Lyapunov run, run on where the heading slipped,
+        with its batch-means error otherwise); lost (bool, :func:`lib.dynamics.verdicts.heading_lost`): the heading slips
         whole turns against the reference: the verdict is ``slipping``, or no attracting orbit is
         reached and the drift differs from zero by more than 3 standard errors plus
         ``slip_band`` (1e-3 turns per period); turns_round (bool,
@@ -199,7 +208,8 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
         run is nearest to: which orbit is reached), distance (rad, from the run's last state to
         that point), residual (rad, Newton's), mirror (rad, on the eight: the distance from
         the orbit to its mirror image, 0 for a symmetric orbit; a positive one coexists with
-        its mirror image, a second attractor), periods (integrated), steps (per period of the fine map), verdict_steps (of the verdict map),
+        its mirror image, a second attractor), periods (integrated until the verdict),
+        drift_periods (of Lyapunov run the drift is measured over; 0 on an orbit), steps (per period of the fine map), verdict_steps (of the verdict map),
         reason (why undecided).
     """
     _check_body_kind(body, kind)
@@ -239,9 +249,6 @@ def _step_counts(body, kind, R, Theta, h_lambda, steps, opts):
     return np.minimum(verdict_steps(body, kind, R, Theta, opts["h_verdict"]), n_fine), n_fine
 
 
-#: Newton on the reduced rotation's period map (exact Jacobian): polished below its
-#: tolerance while the residual still halves
-_NEWTON = dict(max_iter=15, max_step=1.0, polish=1e-13)
 
 #: a clearly chaotic point leaves the Lyapunov run early, at this many standard errors
 EARLY_SIGMAS = 5.0
@@ -252,7 +259,8 @@ def _new_out(N: int) -> dict:
                 floquet=np.full(N, np.nan), lyapunov=np.full(N, np.nan), lyapunov_stderr=np.full(N, np.nan),
                 slip=np.full(N, np.nan), slip_stderr=np.full(N, np.nan), lost=np.zeros(N, bool),
                 orbit_p=np.full(N, np.nan), distance=np.full(N, np.nan), residual=np.full(N, np.nan),
-                mirror=np.full(N, np.nan), periods=np.zeros(N, int), reason=np.full(N, "", dtype=object),
+                mirror=np.full(N, np.nan), periods=np.zeros(N, int), drift_periods=np.zeros(N, int),
+                reason=np.full(N, "", dtype=object),
                 x=np.full((N, 2), np.nan), mult=np.full((N, 2), np.nan + 0j), slip_n=np.zeros(N, int))
 
 
@@ -280,6 +288,7 @@ class _Batch:
         self.hist = np.stack([phi, w], axis=-1)[None]
         self.tried = np.full((opts["max_period"], idx.size), np.inf)
         self.lyap: dict = {}
+        self.pending: list = []              # chaotic points whose drift runs on (run_on)
         self.t = 0
 
     @property
@@ -357,7 +366,7 @@ class _Batch:
         o, out, ly = self.opts, self.out, self.lyap
         g = self.s["idx"][done]
         T = 2 * np.pi / self.Theta[g]
-        lam, se = dv.batch_means(ly["logs"][done, :nb])
+        lam, se = dv.batch_means(ly["logs"][done, :nb], batch_grouping(nb, o["block"])[0])
         out["lyapunov"][g], out["lyapunov_stderr"][g] = lam / T, se / T
         returns = dv.section_returns(ly["sec"][:, done])
         regime, reason = dv.classify(lam, se, returns, band=o["lyapunov_band"], return_tol=o["return_tol"],
@@ -377,8 +386,29 @@ class _Batch:
         out["slip"][g], out["slip_stderr"][g] = drift, dse
         out["range"][g] = ly["hi"][done] - ly["lo"][done]
         out["lost"][g] = dv.heading_lost(False, 0, drift, dse, slip_band=o["slip_band"])
-        out["periods"][g] = self.t
+        out["periods"][g], out["drift_periods"][g] = self.t, nb * o["block"]
+        more = o["drift_periods"] // o["block"] - nb
+        on = np.flatnonzero(done)[np.ptp(ly["pb"][done, :nb + 1], axis=1) >= 2 * np.pi]
+        if more > 0 and on.size:               # a heading that slipped: its drift runs on
+            s = self.s
+            self.pending.append((s["idx"][on], s["phi"][on], s["w"][on], s["A"][on], s["B"][on], s["C"][on],
+                                 ly["pb"][on, :nb + 1], more))
         self.keep(~done)
+
+    def run_on(self) -> None:
+        """The drifts of the chaotic points that left the Lyapunov run early with a heading that
+        slipped, run on without the tangent vector to ``drift_periods`` periods of Lyapunov run:
+        their heading at every further block end, their drift and whether it is lost again."""
+        o, out, eng, B = self.opts, self.out, self.eng, self.opts["block"]
+        for g, phi, w, A, Bc, C, pb, more in self.pending:
+            ends = np.arange(1, more + 1) * B
+            sec = eng.flow(phi, w, A, Bc, C, more * B)["sec"]
+            heading = np.concatenate([pb, (sec[ends - 1, :, 0] - eng.w2pi * ends[:, None]).T], axis=1)
+            drift, dse = dv.heading_drift(heading, B)
+            out["slip"][g], out["slip_stderr"][g] = drift, dse
+            out["lost"][g] = dv.heading_lost(False, 0, drift, dse, slip_band=o["slip_band"])
+            out["drift_periods"][g] = (heading.shape[1] - 1) * B
+        self.pending = []
 
 
 def _decide_group(batch: _Batch) -> None:
@@ -397,18 +427,25 @@ def _decide_group(batch: _Batch) -> None:
     if batch.n == 0 or nb_max < 2:
         return
     batch.start_lyapunov(nb_max)
+    _lyapunov_run(batch, nb_max)
+    batch.run_on()
+
+
+def _lyapunov_run(batch: _Batch, nb_max: int) -> None:
+    """The Lyapunov run of :func:`_decide_group`, in blocks, until every point is decided."""
+    o = batch.opts
     for b in range(nb_max):
         batch.lyapunov_block(b)
         nb = b + 1
         if batch.t - o["transient"] < o["min_lyapunov_periods"] and nb < nb_max:
             continue
-        lam, se = dv.batch_means(batch.lyap["logs"][:, :nb])
+        lam, se = dv.batch_means(batch.lyap["logs"][:, :nb], batch_grouping(nb, o["block"])[0])
         trymask = lam < dv.SIGMAS * se
         if trymask.any():
             batch.try_orbits(np.flatnonzero(trymask))
             if batch.n == 0:
                 break
-            lam, se = dv.batch_means(batch.lyap["logs"][:, :nb])
+            lam, se = dv.batch_means(batch.lyap["logs"][:, :nb], batch_grouping(nb, o["block"])[0])
         final = nb == nb_max
         chaotic = (lam > o["lyapunov_band"]) & (lam > (dv.SIGMAS if final else EARLY_SIGMAS) * se)
         done = chaotic | final
@@ -430,40 +467,3 @@ def _verdict_core(body, kind, R, Theta, p0, v0, n_pts, opts, engine, n_fine=None
         _decide_group(_Batch(_Engine(kind, int(n), engine), body, kind, R, Theta, p0, v0, idx, opts, out))
     _on_fine_map(body, kind, R, Theta, n_pts, n_fine, opts, engine, out)
     return out
-
-
-def _on_fine_map(body, kind, R, Theta, n_pts, n_fine, opts, engine, out) -> None:
-    """Each attracting orbit on the fine map (``n_fine`` steps per period): Newton from the
-    orbit found on the verdict map, its multipliers, and its range sampled at every step
-    (Hermite-refined extremes). An orbit that does not survive is undecided."""
-    orb = np.flatnonzero(np.isin(out["regime"], ("periodic", "slipping")))
-    for n in np.unique(n_fine[orb]):
-        eng = _Engine(kind, int(n), engine)
-        for k in np.unique(out["period"][orb]):
-            g = orb[(n_fine[orb] == n) & (out["period"][orb] == k)]
-            if g.size == 0:
-                continue
-            A, B, C = coefficients(body, R[g], Theta[g])
-            if np.any(n_pts[g] != n):
-                rmap = RotationMap(eng, A, B, C)
-                x, J, res, _, _ = dv.newton(rmap.step, np.arange(g.size), out["x"][g], int(k), turn_axis=0,
-                                         turns=out["slip_n"][g], tol=opts["newton_tol"], **_NEWTON)
-                ok = res <= opts["newton_tol"]
-                mult = np.full((g.size, 2), np.nan + 0j)
-                if ok.any():
-                    mult[ok] = floquet_multipliers(J[ok])
-                ok &= np.abs(mult[:, 0]) < 1.0
-                bad = g[~ok]
-                out["regime"][bad] = "undecided"
-                out["reason"][bad] = "the orbit of the verdict map is not an attracting orbit of the fine map"
-                out["period"][bad], out["lost"][bad] = 0, False
-                for key in ("floquet", "lyapunov", "slip", "slip_stderr", "orbit_p", "distance"):
-                    out[key][bad] = np.nan
-                g, A, B, C, x, mult, res = g[ok], A[ok], B[ok], C[ok], x[ok], mult[ok], res[ok]
-                out["x"][g], out["mult"][g], out["residual"][g] = x, mult, res
-                mod = np.abs(mult[:, 0])
-                out["floquet"][g] = mod
-                out["lyapunov"][g] = np.log(mod) * Theta[g] / (2 * np.pi * k)
-                if g.size == 0:
-                    continue
-            out["range"][g], out["mirror"][g] = orbit_range(eng, out["x"][g], A, B, C, int(k), out["slip_n"][g])
