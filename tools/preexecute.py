@@ -55,11 +55,11 @@ AFTER_CHAPTERS = ("methods",)
 #: instead of 127). Each point of a parallel loop is computed alone, so the results do not
 #: depend on the threads (``make test-portable`` runs the tests on one).
 KERNEL_ENV = {"OPENBLAS_NUM_THREADS": "1"}
-#: a page's CPU time (s), measured (the log of ``make book`` in a fresh clone, numba's kernels
-#: compiled on the way, 2026-11-28), to start the longest first (unknown pages first of all)
-COST = {"chapters/08_optimal": 86, "chapters/04_limits": 79, "chapters/05_stability": 62,
-        "chapters/03_tracking": 14, "chapters/07_percussion": 13, "chapters/06_allocation": 12,
-        "chapters/02_controllability": 8, "chapters/01_model": 3, "methods": 23}
+#: a page's CPU time (s), measured (the log of ``make book``, 2026-11-28), to start the longest first
+#: (unknown pages first of all)
+COST = {"chapters/05_stability": 70, "chapters/04_limits": 69, "chapters/08_optimal": 63,
+        "chapters/03_tracking": 13, "chapters/07_percussion": 11, "chapters/06_allocation": 11,
+        "chapters/02_controllability": 8, "chapters/01_model": 3, "methods": 40}
 
 
 def kernel_env(jobs: int, cores: int | None = None) -> dict:
