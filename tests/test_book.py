@@ -26,6 +26,20 @@ def test_book_builds_with_no_warnings(built_book):
 
 
 @pytest.mark.book
+def test_no_page_shows_a_warning_or_other_stderr_output(built_book):
+    """A page's code writes nothing to stderr: a warning printed on the page (a NaN cast to an
+    integer, a deprecation) is a defect the reader sees, and a stderr block also breaks the
+    page's width at 1280 px."""
+    html = ROOT / "_build" / "html"
+    shown = {p.relative_to(html).as_posix(): re.findall(r'class="output stderr.*?<pre>(.*?)</pre>',
+                                                       p.read_text(), flags=re.S)
+             for p in html.rglob("*.html") if "_static" not in p.parts}
+    shown = {page: blocks for page, blocks in shown.items() if blocks}
+    assert not shown, "pages with stderr output:\n" + "\n".join(
+        f"{page}: {re.sub(r'<[^>]+>', '', blocks[0])[:300]}" for page, blocks in shown.items())
+
+
+@pytest.mark.book
 def test_every_page_was_executed_two_at_a_time_before_the_build(built_book):
     """``tools/preexecute.py`` executed every notebook page into the execution cache, and the
     build found each there: a page whose cache key the build did not match (another reader or

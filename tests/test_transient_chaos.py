@@ -144,3 +144,17 @@ def test_a_slipping_orbit_of_period_two_reached_late_is_the_same_orbit_when_deci
     c = confirm_attractors(BODY, "eight", frame, x0=(p0, 0.0))
     assert c.confirmed.iloc[0] == 1
     assert c.regime.iloc[0] == "slipping" and c.period.iloc[0] == 2, c.reason.iloc[0]
+
+
+def test_a_chaotic_row_whose_longer_drift_run_ended_undecided_is_confirmed_without_a_warning():
+    # confirm_lost leaves slip NaN where the longer run decided nothing; confirm_attractors then
+    # decides the row again (a chaotic first decision) without casting that NaN to turns
+    import warnings
+
+    f = eight_rotation_sweep(BODY, [FLIP[0]], [FLIP[1]])
+    assert f.regime.iloc[0] in ("chaotic", "periodic", "slipping")
+    f.loc[:, ["regime", "period", "slip", "slip_stderr"]] = ["chaotic", 0, np.nan, np.nan]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        c = confirm_attractors(BODY, "eight", f)
+    assert c.confirmed.iloc[0] == 1 and c.regime.iloc[0] in ("chaotic", "transient")

@@ -108,7 +108,7 @@ def _redo(body, kind, frame, rows, opts, *, start=0.0, steps_factor=1, x0=(0.0, 
     p0, v0 = (np.array([perturbed(x, start) for x in x0]) if start else x0).T.copy()
     out = _verdict_core(body, kind, R, Th, p0, v0, n_pts * steps_factor, opts, "numba", n_fine)
     k1 = frame.period.to_numpy()[rows]
-    n1 = np.rint(frame.slip.to_numpy()[rows] * k1).astype(int)
+    n1 = np.rint(np.nan_to_num(frame.slip.to_numpy()[rows]) * k1).astype(int)   # turns of an orbit (k1 > 0)
     cand = np.flatnonzero(np.isin(out["regime"], dv.ORBIT_REGIMES) & (out["period"] == k1) & (out["slip_n"] == n1))
     same = np.zeros(rows.size, bool)
     for n in np.unique(n_fine[cand]):
