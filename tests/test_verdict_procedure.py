@@ -888,6 +888,8 @@ def test_a_long_run_merges_its_blocks_into_batches_of_at_most_48_periods_and_at_
     assert [statistics.batch_grouping(nb, 12.0) for nb in (6, 11, 12, 25, 100)] == [
         (1, 6), (1, 11), (2, 6), (4, 6), (4, 25)]
     assert statistics.batch_grouping(10, 96.0) == (1, 10)    # blocks already longer than 48 periods
+    g, n = statistics.batch_grouping(np.array([6, 12, 25, 100]), 12.0)     # many runs at once
+    assert g.tolist() == [1, 2, 4, 4] and n.tolist() == [6, 6, 6, 25]
     assert (statistics.MIN_BATCHES, statistics.BATCH_PERIODS) == (6, 48)
     rng = np.random.default_rng(3)
     q = np.cumsum(np.r_[0.0, rng.normal(size=25)])[None]   # 25 blocks: 6 increments of 48 periods
@@ -915,6 +917,10 @@ def test_a_long_run_merges_its_blocks_into_batches_of_at_most_48_periods_and_at_
     np.testing.assert_allclose(mean, merged.mean(axis=1), rtol=1e-12, atol=0)  # accuracy: the same sums in another order
     np.testing.assert_allclose(err, merged.std(axis=1, ddof=1) / np.sqrt(6), rtol=1e-12, atol=0)  # accuracy: as above
     assert np.array_equal(dv.batch_means(means, 1)[1], dv.batch_means(means)[1])  # exact: merge 1 keeps every block
+    long = statistics.long_run_means(means, 12.0)             # 25 blocks of 12 periods: merged 4 at a time
+    assert np.array_equal(long[0], mean) and np.array_equal(long[1], err)  # exact: the same call
+    with pytest.raises(ValueError, match="block_means"):
+        statistics.long_run_means(means[0], 12.0)
     for bad in (0, 1.5):
         with pytest.raises(ValueError, match="merge"):
             dv.batch_means(means, bad)

@@ -44,8 +44,8 @@ from .statistics import batch_grouping, batch_means, block_statistics, heading_d
 __all__ = ["ensemble_ratio", "limit_ensemble", "rotation_ensemble", "calibration_study", "ratio_table", "LIMIT_DEG",
            "heading_variogram", "VARIOGRAM_LAGS", "move_counts", "exponent_moves",
            "FIG5_POINTS",
-           "LIMIT_STARTS", "ROTATION_STARTS", "VARIOGRAM_STARTS", "BURN_IN", "LIMIT_PERIODS", "RMS_PERIODS", "START_SPREAD",
-           "RATIO_BAND", "LEVEL", "RMS_BLOCK", "SHORT_BLOCKS"]
+           "LIMIT_STARTS", "ROTATION_STARTS", "VARIOGRAM_STARTS", "BURN_IN", "LIMIT_PERIODS", "RMS_PERIODS",
+           "START_SPREAD", "RATIO_BAND", "LEVEL", "RMS_BLOCK", "SHORT_BLOCKS"]
 
 #: the angle limits (deg) studied, without a cap, on Chapter 4's eight (R = 2 m, Theta = pi/4 rad/s)
 LIMIT_DEG = (30, 45)
@@ -362,9 +362,8 @@ def exponent_moves(body: Body, frame: pd.DataFrame, *, steps_factor: int = 2, ev
     out = _redo(body, "eight", frame, rows, opts, steps_factor=steps_factor)
     both = out["regime"] == "chaotic"
     first = frame.iloc[rows[both]]
-    def blocks(periods):        # the batches behind each error: the blocks, merged as batch_means merges them
-        nb = (np.asarray(periods) - opts["transient"]) // opts["block"]
-        return np.array([batch_grouping(n, opts["block"])[1] for n in nb], dtype=int)
+    def blocks(periods):        # the batches behind each error: the blocks, merged as a long run's are
+        return batch_grouping((np.asarray(periods) - opts["transient"]) // opts["block"], opts["block"])[1]
     res = move_counts(first.lyapunov, first.lyapunov_stderr, blocks(first.periods), out["lyapunov"][both],
                       out["lyapunov_stderr"][both], blocks(out["periods"][both]), sigmas)
     return dict(res, chaotic=int(rows.size))

@@ -28,7 +28,7 @@ from ..angles import wrap_angle
 
 __all__ = ["block_statistics", "batch_means", "drift_statistics", "heading_drift", "integrated_time", "block_length",
            "section_returns", "BLOCK_TAUS", "SOKAL_WINDOW", "MIN_BATCHES", "BATCH_PERIODS",
-           "batch_grouping"]
+           "batch_grouping", "long_run_means"]
 
 #: a block is at least this many integrated autocorrelation times long, so that the batch-means
 #: variance of an AR(1) series is then biased low by less than 1 / BLOCK_TAUS (its standard
@@ -153,16 +153,17 @@ def block_statistics(per_period, block: int) -> tuple[np.ndarray, np.ndarray]:
     return mean, se
 
 
-def batch_grouping(n_blocks: int, block_periods: float, batches: int = MIN_BATCHES,
-                   longest: float = BATCH_PERIODS) -> tuple[int, int]:
+def batch_grouping(n_blocks, block_periods: float, batches: int = MIN_BATCHES,
+                   longest: float = BATCH_PERIODS) -> tuple:
     """How :func:`batch_means` merges a run of ``n_blocks`` blocks of ``block_periods`` periods:
     g consecutive blocks a batch, g = nb // ``batches`` but no batch longer than ``longest``
-    periods (and g >= 1), over the last (nb // g) g blocks. Returns (g, number of batches).
+    periods (and g >= 1), over the last (nb // g) g blocks. Returns (g, number of batches):
+    ints for one run, arrays for an array of runs.
 
     Parameters
     ----------
-    n_blocks : int
-        Blocks in the run (>= 1).
+    n_blocks : int or array_like
+        Blocks in the run (>= 1), or in each run.
     block_periods : float
         Periods a block (> 0).
     batches : int
@@ -179,9 +180,32 @@ def batch_grouping(n_blocks: int, block_periods: float, batches: int = MIN_BATCH
         raise ValueError(f"batches must be a whole number >= 2, got {batches!r}")
     if not block_periods > 0:
         raise ValueError(f"block_periods must be positive, got {block_periods!r}")
-    nb = int(n_blocks)
-    g = max(1, min(nb // int(batches), int(longest // block_periods)))
-    return g, nb // g
+    nb = np.asarray(n_blocks).astype(int)
+    g = np.maximum(1, np.minimum(nb // int(batches), int(longest // block_periods)))
+    return (int(g), int(nb // g)) if nb.ndim == 0 else (g, nb // g)
+
+
+def long_run_means(block_means, block_periods: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`batch_means` of a run's block means (N, nb), blocks of ``block_periods`` periods,
+    merged into longer batches as a long run is (:func:`batch_grouping`). Returns (mean (N,),
+    stderr (N,)).
+
+    Parameters
+    ----------
+    block_means : array_like
+        Block means (N, nb).
+    block_periods : float
+        Periods a block (> 0).
+
+    Returns
+    -------
+    mean, stderr : numpy.ndarray
+        (N,) each.
+    """
+    m = np.asarray(block_means, dtype=float)
+    if m.ndim != 2:
+        raise ValueError(f"block_means must have shape (N, nb), got {m.shape}")
+    return batch_means(m, batch_grouping(m.shape[1], block_periods)[0])
 
 
 def batch_means(block_means, merge: int = 1) -> tuple[np.ndarray, np.ndarray]:

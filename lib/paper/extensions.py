@@ -91,8 +91,8 @@ def lost_false_positives(frame: pd.DataFrame) -> tuple[int, float]:
     and again over ``LOST_FACTOR`` h (:func:`lib.rotation.fig5.confirm_lost`); the standard
     error comes from the means of batches (:func:`lib.dynamics.statistics.batch_grouping`). With
     independent, normal batch means and no drift, the longer run's statistic is Student's t with
-    (batches - 1) degrees of freedom, so a point is called lost with probability at most 2 P(T > SIGMAS); summed over
-    the points decided by the test.
+    (batches - 1) degrees of freedom, so a point is called lost with probability at most
+    2 P(T > SIGMAS); summed over the points decided by the test.
 
     Parameters
     ----------
@@ -110,8 +110,7 @@ def lost_false_positives(frame: pd.DataFrame) -> tuple[int, float]:
     opts = VERDICT_DEFAULTS
     no_orbit = ~frame.regime.isin(ORBIT_REGIMES).to_numpy()
     h = frame.drift_periods.to_numpy()[no_orbit]                        # the first drift's run
-    batches = [batch_grouping(LOST_FACTOR * n // opts["block"], opts["block"])[1] for n in h]
-    dof = np.maximum(np.array(batches, dtype=int) - 1, 1)
+    dof = np.maximum(batch_grouping(LOST_FACTOR * h // opts["block"], opts["block"])[1] - 1, 1)
     return int(no_orbit.sum()), float(np.sum(2 * stats.t.sf(SIGMAS, dof)))
 
 

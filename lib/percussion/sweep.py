@@ -73,8 +73,8 @@ def heading_sweep(body: Body, R, Theta, *, kind: str = "eight", p0=0.0, executor
     eight (28) by default) of size R_i (m) at Theta_i (rad/s), from p(0) = ``p0`` (rad), with
     the columns of :func:`lib.stability.eight_rotation_sweep` (R, Theta, regime, period, range,
     floquet, lyapunov, lyapunov_stderr, slip, slip_stderr, lost, orbit_p, distance, residual,
-    mirror, periods, drift_periods, reason, turns_round, steps, verdict_steps). ``executor``, ``chunk_size``,
-    ``progress``: as in :func:`lib.machinery.parallel.map_chunks`. ``options``: :data:`SWEEP_DEFAULTS`.
+    mirror, periods, drift_periods, reason, turns_round, steps, verdict_steps). ``executor``,
+    ``chunk_size``, ``progress``: as in :func:`lib.machinery.parallel.map_chunks`. ``options``: :data:`SWEEP_DEFAULTS`.
 
     Parameters
     ----------

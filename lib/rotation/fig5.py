@@ -200,8 +200,8 @@ def confirm_attractors(body: Body, kind: str, frame: pd.DataFrame, confirm=("per
 def confirm_lost(body: Body, kind: str, frame: pd.DataFrame, factor: int = LOST_FACTOR, *, x0=(0.0, 0.0),
                  **options) -> pd.DataFrame:
     """A copy of a frame of :func:`lib.rotation.verdicts.rotation_verdicts` whose headings lost
-    without a slipping orbit (from the reference, or from ``x0`` as in :func:`confirm_attractors`; a drift test over
-    h periods of Lyapunov run, the frame's ``drift_periods``) are decided again from the same
+    without a slipping orbit (from the reference, or from ``x0`` as in :func:`confirm_attractors`;
+    a drift test over h periods of Lyapunov run, the frame's ``drift_periods``) are decided again from the same
     start over a Lyapunov run of ``factor`` h periods, every block of it
     (no early stop): ``lost`` stays True only where the heading is lost again
     (:func:`lib.dynamics.verdicts.heading_lost`: a slipping orbit, or the drift more than 3

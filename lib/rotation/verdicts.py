@@ -24,7 +24,7 @@ import pandas as pd
 from ..machinery import checks
 from ..angles import wrap_angle
 from ..dynamics import verdicts as dv
-from ..dynamics.statistics import batch_grouping
+from ..dynamics.statistics import long_run_means
 from ..machinery.parallel import concat_frames, map_chunks
 from ..params import Body
 from .reduced import ENGINES, check_grid, _initial
@@ -135,7 +135,7 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
        2 pi / Theta, its standard error from the means of blocks of ``block`` (12)
        periods (batch means, so that correlated periods do not shrink it; a long run merges
        them into batches of up to 48 periods, at least 6 of them, as the drift's,
-       :func:`lib.dynamics.statistics.batch_grouping`). After every block from
+       :func:`lib.dynamics.statistics.long_run_means`). After every block from
        ``min_lyapunov_periods`` (72) on, a point that is not clearly
        expanding is handed to Newton again, and a clearly chaotic one (lambda T above
        the band and 5 standard errors) stops. If its heading has moved a whole turn, it
@@ -199,8 +199,8 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
         floquet (largest multiplier modulus); lyapunov, lyapunov_stderr (1/s; for an orbit
         ln|mu_1| / (k T) with no error); slip, slip_stderr (turns of p per period: n / k on
         an orbit, the measured drift over the Lyapunov run, run on where the heading slipped,
-        with its batch-means error otherwise); lost (bool, :func:`lib.dynamics.verdicts.heading_lost`): the heading slips
-        whole turns against the reference: the verdict is ``slipping``, or no attracting orbit is
+        with its batch-means error otherwise); lost (bool, :func:`lib.dynamics.verdicts.heading_lost`):
+        the heading slips whole turns against the reference: the verdict is ``slipping``, or no attracting orbit is
         reached and the drift differs from zero by more than 3 standard errors plus
         ``slip_band`` (1e-3 turns per period); turns_round (bool,
         :func:`lib.dynamics.verdicts.turns_round`): the other reading, range > 2 pi, whether or
@@ -209,8 +209,8 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
         that point), residual (rad, Newton's), mirror (rad, on the eight: the distance from
         the orbit to its mirror image, 0 for a symmetric orbit; a positive one coexists with
         its mirror image, a second attractor), periods (integrated until the verdict),
-        drift_periods (of Lyapunov run the drift is measured over; 0 on an orbit), steps (per period of the fine map), verdict_steps (of the verdict map),
-        reason (why undecided).
+        drift_periods (of Lyapunov run the drift is measured over; 0 on an orbit), steps (per
+        period of the fine map), verdict_steps (of the verdict map), reason (why undecided).
     """
     _check_body_kind(body, kind)
     checks.one_of("engine", engine, sorted(ENGINES))
@@ -247,7 +247,6 @@ def _step_counts(body, kind, R, Theta, h_lambda, steps, opts):
         return n, n
     n_fine = verdict_steps(body, kind, R, Theta, h_lambda)
     return np.minimum(verdict_steps(body, kind, R, Theta, opts["h_verdict"]), n_fine), n_fine
-
 
 
 #: a clearly chaotic point leaves the Lyapunov run early, at this many standard errors
@@ -366,7 +365,7 @@ class _Batch:
         o, out, ly = self.opts, self.out, self.lyap
         g = self.s["idx"][done]
         T = 2 * np.pi / self.Theta[g]
-        lam, se = dv.batch_means(ly["logs"][done, :nb], batch_grouping(nb, o["block"])[0])
+        lam, se = long_run_means(ly["logs"][done, :nb], o["block"])
         out["lyapunov"][g], out["lyapunov_stderr"][g] = lam / T, se / T
         returns = dv.section_returns(ly["sec"][:, done])
         regime, reason = dv.classify(lam, se, returns, band=o["lyapunov_band"], return_tol=o["return_tol"],
@@ -439,13 +438,13 @@ def _lyapunov_run(batch: _Batch, nb_max: int) -> None:
         nb = b + 1
         if batch.t - o["transient"] < o["min_lyapunov_periods"] and nb < nb_max:
             continue
-        lam, se = dv.batch_means(batch.lyap["logs"][:, :nb], batch_grouping(nb, o["block"])[0])
+        lam, se = long_run_means(batch.lyap["logs"][:, :nb], o["block"])
         trymask = lam < dv.SIGMAS * se
         if trymask.any():
             batch.try_orbits(np.flatnonzero(trymask))
             if batch.n == 0:
                 break
-            lam, se = dv.batch_means(batch.lyap["logs"][:, :nb], batch_grouping(nb, o["block"])[0])
+            lam, se = long_run_means(batch.lyap["logs"][:, :nb], o["block"])
         final = nb == nb_max
         chaotic = (lam > o["lyapunov_band"]) & (lam > (dv.SIGMAS if final else EARLY_SIGMAS) * se)
         done = chaotic | final
