@@ -64,7 +64,7 @@ test: $(STAMP)
 	BOOK_REBUILD= $(BIN)/python -m pytest -m "book or browser"; slow=$$?; \
 	test $$fast = 0 && test $$slow = 0
 
-# The fast tests again under another machine's arithmetic, emulated on this one (README:
+# The fast tests, then the book, again under another machine's arithmetic, emulated on this one (README:
 # "Another machine's arithmetic"): numba compiles for its generic x86-64 target (no AVX, no
 # FMA contraction) into a cache of its own, so that it neither reads nor overwrites the native
 # one; OpenBLAS (numpy's and scipy's) runs its most generic kernel; numpy's SIMD loops above
@@ -75,9 +75,17 @@ PORTABLE_ENV := NUMBA_CPU_NAME=generic NUMBA_CACHE_DIR=$(CURDIR)/_build/numba-ge
 	NUMBA_NUM_THREADS=1 OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1 \
 	PYTHONHASHSEED=0
 
+# Then the book's pages themselves, executed afresh under the same arithmetic (their `assert`s run
+# there), and the book's tests on that build (warnings, stderr, the kinds of the glued numbers). The
+# results the pages share (`_build/.cache`) are emptied first, so that no page reads what the native
+# build computed. This build replaces the native one in _build.
 test-portable: $(STAMP)
 	@mkdir -p _build/numba-generic
 	$(PORTABLE_ENV) nice -n 10 $(BIN)/python -m pytest -n 2 --dist worksteal -m "not book and not browser" -p no:cacheprovider
+	rm -rf _build/.cache
+	$(PORTABLE_ENV) $(MAKE) --no-print-directory book > _build/book-portable.out 2>&1 || \
+	  { tail -n 60 _build/book-portable.out; echo "The book failed under the portable arithmetic (_build/book-portable.out)"; exit 1; }
+	$(PORTABLE_ENV) $(BIN)/python -m pytest -m "book and not packaging" -p no:cacheprovider
 
 benchmark: $(STAMP)
 	$(BIN)/python benchmarks/bench_switched.py

@@ -43,6 +43,7 @@ def test_the_certified_bound_of_the_issue_is_written_below_itself():
     assert kinds.lower_bound(0.10769, ".4f").text() == "0.1076"
     assert kinds.best_found(0.10776, ".4f").text() == "0.1078"
     assert kinds.upper_bound(0.10770, ".3g").text() == "0.108"
+    assert kinds.at_most(0.10761, ".3f").text() == "0.108" and kinds.at_least(0.10769, ".3f").text() == "0.107"
     assert kinds.exact(0.10769, ".3f").text() == "0.108"
 
 
@@ -88,6 +89,17 @@ FLOOR_WORDS = ("at least", "no less than", "no closer than", "closer to the eigh
 #: "under" are not read: they also state a range ("held up to w = x", "below x it holds"), where
 #: the safe side is the other one; such a number is glued with its kind (lower_bound, upper_bound)
 CEILING_WORDS = ("at most", "no more than", "within")
+#: every word that bounds the number after it (issue 57): the number must carry a kind whose rounding
+#: says which side is safe (a bound, a motion found), or be a count or a whole number (an input such as
+#: "up to 8 periods"), so that the sentence is true on any CPU by construction, not by how one
+#: machine's last digit rounded. A plain float here is refused, whatever it rounds to on this machine.
+BOUND_WORDS = FLOOR_WORDS + CEILING_WORDS + ("below", "above", "up to", "under")
+#: the kinds that may follow a bounding word
+BOUND_KINDS = tuple(k.value for k in kinds.BOUNDS) + (Kind.COUNT.value, Kind.SETTING.value)
+#: a computed number below this in magnitude is at round-off scale (kinds.ROUNDOFF): printed as
+#: measured, it is the last bits of one machine. It is printed instead as the bound its method
+#: guarantees (kinds.within_accuracy), with the method named beside it; a setting is exact.
+ROUNDOFF = kinds.ROUNDOFF
 GLUE_TEXT = re.compile(r"\{glue:text\}`(?:[^`:]+::)?([A-Za-z0-9_]+)(?::([^`]*))?`")
 
 
@@ -95,6 +107,12 @@ def words_before(source: str, start: int) -> str:
     """The few words before a glue role, on its line or the one before, lower case."""
     head = re.sub(r"\s+", " ", source[max(0, start - 40):start]).lower()
     return head
+
+
+def bounding_word(head: str) -> str | None:
+    """The bounding word (``BOUND_WORDS``) that the words before a number end with, if any."""
+    tail = head.rstrip()
+    return next((w for w in BOUND_WORDS if re.search(rf"\b{w}$", tail)), None)
 
 
 def reading(head: str) -> str | None:
@@ -141,7 +159,16 @@ def check_page(source: str, glued: dict) -> list[str]:
             bad.append(f"{key}: a lower bound {value!r} printed above itself as {shown}")
         if record and Kind(record["kind"]).rounding == "up" and shown < value:
             bad.append(f"{key}: an upper bound {value!r} printed below itself as {shown}")
-        claim = reading(words_before(source, m.start()))
+        head = words_before(source, m.start())
+        word = bounding_word(head)
+        kind = record["kind"] if record else None
+        if word and kind not in BOUND_KINDS and not (kind is None and float(value).is_integer()):
+            bad.append(f"{key}: '{word} {shown}' is a {kind or 'plain number'}, not a bound: glue it with "
+                       "its kind (lower_bound, upper_bound, best_found) so its rounding is on the safe side")
+        if 0 < abs(value) < ROUNDOFF and kind not in BOUND_KINDS:
+            bad.append(f"{key}: {value!r} is at round-off scale, printed as a {kind or 'plain number'}: "
+                       "print the bound its method guarantees, and name the method")
+        claim = reading(head)
         if claim == "floor" and shown > value:
             bad.append(f"{key}: 'at least {shown}' but the value is {value!r}")
         if claim == "ceiling" and shown < value:
@@ -155,8 +182,48 @@ def test_the_page_check_catches_a_bound_rounded_up_and_a_floor_above_its_value()
     bound = kinds.lower_bound(0.10769, ".4f")
     assert not check_page("closer to the eight than {glue:text}`b` m", {"b": (repr(bound.text()), bound.record())})
     assert check_page("than {glue:text}`b:.3f` m", {"b": (repr(bound.text()), bound.record())})
-    assert not check_page("at most {glue:text}`r:.2f`", {"r": (repr(0.0281), None)})   # 0.03 >= 0.0281
-    assert check_page("at most {glue:text}`r:.2f`", {"r": (repr(0.0241), None)})       # 0.02 < 0.0241
+    ceiling = kinds.upper_bound(0.0281, ".2f")                                           # 0.03 >= 0.0281
+    assert not check_page("at most {glue:text}`r`", {"r": (repr(ceiling.text()), ceiling.record())})
+    assert any("'at most 0.02' but" in b for b in check_page("at most {glue:text}`r:.2f`", {"r": (repr(0.0241), None)}))
+
+
+def test_a_plain_float_after_a_bounding_word_is_refused_whatever_it_rounds_to():
+    # Chapter 5's p_sim_gap: 'within 5e-14' read true on one CPU (5.4e-14 rounded up) and false on
+    # another (5.1e-14 rounded down). A plain float after a bounding word fails on both.
+    for value in (5.4e-14 * 1e10, 5.1e-14 * 1e10):          # the same check away from round-off
+        bad = check_page("ends within {glue:text}`g:.0e` rad of it", {"g": (repr(value), None)})
+        assert any("not a bound" in b for b in bad), bad
+    for word in ("below", "above", "up to", "under", "at least", "at most", "within"):
+        assert check_page(f"it is {word} {{glue:text}}`g:.2f` m", {"g": (repr(0.123), None)}), word
+    bound = kinds.upper_bound(0.123, ".2f")
+    assert not check_page("within {glue:text}`g` m", {"g": (repr(bound.text()), bound.record())})
+    # a whole number (an input: "up to 8 periods") and a count need no kind; "below" inside a word does not bound
+    assert not check_page("up to {glue:text}`n` periods", {"n": ("8", None)})
+    assert not check_page("the belowground {glue:text}`g:.2f` m", {"g": (repr(0.123), None)})
+
+
+def test_a_value_at_round_off_scale_is_refused_unless_printed_as_a_bound():
+    assert any("round-off" in b for b in check_page("differs by {glue:text}`d:.0e` rad", {"d": (repr(5.1e-14), None)}))
+    est = kinds.exact(5.1e-14, ".1e")
+    assert any("round-off" in b for b in check_page("is {glue:text}`d` rad", {"d": (repr(est.text()), est.record())}))
+    tol = kinds.upper_bound(2.1e-10, ".0e")
+    assert not check_page("within {glue:text}`d` rad", {"d": (repr(tol.text()), tol.record())})
+    assert not check_page("is {glue:text}`d` rad", {"d": ("0.0", None)})       # an exact zero is not round-off
+
+
+def test_a_round_off_value_is_printed_as_its_methods_bound_ten_times_above_it():
+    assert kinds.within_accuracy(5.1e-14, 2.1e-9).text() == "3e-09"         # rounded up, as a bound
+    assert kinds.within_accuracy(-5.4e-14, 2.1e-9).kind is Kind.CEILING
+    with pytest.raises(ValueError, match="ten times"):
+        kinds.within_accuracy(3e-10, 2.1e-9)                                 # not round-off: a margin of 7
+    with pytest.raises(ValueError, match="measured"):
+        kinds.within_accuracy(float("nan"), 1e-9)
+
+
+def test_a_setting_is_written_exactly_or_refused():
+    assert kinds.setting(1e-10, ".0e").text() == "1e-10" and kinds.setting(0.05, ".2f").text() == "0.05"
+    with pytest.raises(ValueError, match="exactly"):
+        kinds.setting(0.05, ".1f")
 
 
 def executed_pages() -> dict[str, dict]:

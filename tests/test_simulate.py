@@ -124,3 +124,20 @@ def test_the_compiled_rates_of_the_paper_law_are_the_closed_loop_to_rounding(kin
         assert clipped > 0 or limits.force is None
     assert paper_rates(body, gains, ref, Allocation("least_squares", (1.0, 1.0, 0.1))) is None
     assert paper_rates(body, gains, object()) is None               # not a path of lib.trajectories
+
+
+def test_a_runs_accuracy_bounds_its_error_against_the_closed_form_of_eq24_with_a_margin_of_ten():
+    # Integration.accuracy (Methods, "What a computed number is accurate to") is what the book prints
+    # in place of round-off; on the paper's circle the simulated position error's deviation from the
+    # analytic solution of (24) lies at least ten times below it, and a run ten times looser does not
+    # keep that margin under the strict accuracy (the bound is not so wide that it cannot fail)
+    from lib.tracking.runs import position_deviation_from_eq24
+    ref = T.circle(R=2.0, theta=np.pi / 4)
+    strict = Integration().accuracy(2.0)
+    assert strict == pytest.approx(10 * (1e-10 + 2 * 1e-10))
+    res = simulate(Body(), Gains(), ref, 2 * ref.period)
+    assert 10 * position_deviation_from_eq24(Body(), Gains(), res) <= strict
+    loose = simulate(Body(), Gains(), ref, 2 * ref.period, integration=Integration(rtol=1e-6, atol=1e-6))
+    assert 10 * position_deviation_from_eq24(Body(), Gains(), loose) > strict
+    with pytest.raises(ValueError, match="scale"):
+        Integration().accuracy(0.0)

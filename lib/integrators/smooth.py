@@ -42,6 +42,27 @@ class Integration:
     blowup: float = 1e8
     switching: str = "stepsize"
 
+    def accuracy(self, scale: float) -> float:
+        """The error the book takes a run of a smooth, contracting loop to hold: ten times the
+        per-step tolerance at the state's ``scale``, 10 (atol + rtol scale), in the state's unit.
+        A value a run gives below it is round-off for this method, and the page prints this bound
+        instead (:func:`lib.machinery.kinds.within_accuracy`); Chapter 3 checks it against the
+        closed form of (24).
+
+        Parameters
+        ----------
+        scale : float
+            The magnitude of the state's components concerned (m, rad), > 0.
+
+        Returns
+        -------
+        float
+            The accuracy, in the unit of ``scale``.
+        """
+        if isinstance(scale, bool) or not np.isscalar(scale) or not scale > 0 or not math.isfinite(scale):
+            raise ValueError(f"scale: a positive finite number, got {scale!r}")
+        return 10.0 * (self.atol + self.rtol * float(scale))
+
     def __post_init__(self) -> None:
         for name in ("rtol", "atol", "max_step", "blowup"):
             v = getattr(self, name)

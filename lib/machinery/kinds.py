@@ -6,11 +6,17 @@ A number the book prints is one of a few kinds (``Methods``, "A number and its k
 - **certified lower bound**: no motion or controller does better: rounded **down**, so that the
   printed value is still a bound;
 - **certified upper bound**: rounded **up**, for the same reason;
+- **at most** / **at least**: a bound that holds to the accuracy of the computation that gave it
+  (an integration's tolerance, the largest value over a run, a tolerance the book sets), not
+  certified: rounded up / down. A value at round-off scale is printed as such a bound, the one its
+  method guarantees, never as the last bits one machine produced;
 - **best found**: the value of a motion a local optimiser found: an upper bound on the least
   possible (rounded up), never called "the best";
 - **estimate**: a statistic of a run, written with its standard error (``0.30 ± 0.02``), the
   error rounded up;
-- **count**: an integer, of a stated total.
+- **count**: an integer, of a stated total;
+- **setting**: a value the book chooses (a tolerance, a horizon, a step), written exactly as the code
+  uses it: after "within" it states the book's own criterion, true by construction.
 
 The code that computes a number says its kind by wrapping it (:func:`lower_bound`,
 :func:`best_found`, ...); :func:`lib.machinery.glue.glue` then glues the text this module renders,
@@ -27,8 +33,9 @@ from dataclasses import dataclass
 from decimal import ROUND_CEILING, ROUND_FLOOR, ROUND_HALF_EVEN, Decimal
 from enum import Enum
 
-__all__ = ["Kind", "Number", "exact", "lower_bound", "upper_bound", "best_found", "estimate", "count",
-           "round_directed", "MIME"]
+__all__ = ["Kind", "Number", "exact", "lower_bound", "upper_bound", "at_most", "at_least", "best_found",
+           "estimate", "count", "setting", "within_accuracy", "round_directed", "MIME", "BOUNDS",
+           "ROUNDOFF"]
 
 #: the MIME type under which a glued number carries its value and kind beside its text
 MIME = "application/vnd.korczak.number+json"
@@ -41,13 +48,26 @@ class Kind(str, Enum):
     LOWER = "certified lower bound"
     UPPER = "certified upper bound"
     FOUND = "best found"
+    CEILING = "at most"
+    FLOOR = "at least"
     ESTIMATE = "estimate"
     COUNT = "count"
+    SETTING = "setting"
 
     @property
     def rounding(self) -> str:
         """The kind's rounding, "down", "up" or "nearest"."""
-        return {Kind.LOWER: "down", Kind.UPPER: "up", Kind.FOUND: "up"}.get(self, "nearest")
+        return {Kind.LOWER: "down", Kind.UPPER: "up", Kind.FOUND: "up", Kind.CEILING: "up",
+                Kind.FLOOR: "down"}.get(self, "nearest")
+
+
+#: the kinds that bound a quantity from one side: a number after "within", "at most", "at least",
+#: "below", "above" or "up to" is one of these (or a count), so that the sentence holds on any CPU
+BOUNDS = (Kind.LOWER, Kind.UPPER, Kind.FOUND, Kind.CEILING, Kind.FLOOR)
+#: below this magnitude a computed value of the book's quantities (of order 1 in SI units) is at
+#: round-off scale: its digits are one machine's last bits, so it is never printed as measured
+#: (:func:`within_accuracy` prints the bound its method guarantees instead)
+ROUNDOFF = 1e-9
 
 
 _MODES = {"down": ROUND_FLOOR, "up": ROUND_CEILING, "nearest": ROUND_HALF_EVEN}
@@ -137,6 +157,9 @@ class Number:
             object.__setattr__(self, "value", float(self.value))
             if self.total is not None:
                 raise ValueError(f"total: only a count has a total, not a {kind.value}")
+            if kind is Kind.SETTING and Decimal(self.text()) != Decimal(repr(self.value)):
+                raise ValueError(f"fmt: a setting is written exactly, but {self.fmt!r} writes "
+                                 f"{self.value!r} as {self.text()!r}")
         if (kind is Kind.ESTIMATE) != (self.stderr is not None):
             raise ValueError("stderr: an estimate carries its standard error, and only an estimate does")
         if self.stderr is not None and not (math.isfinite(self.stderr) and self.stderr >= 0):
@@ -216,6 +239,103 @@ def upper_bound(value: float, fmt: str = ".3g") -> Number:
         The number with its kind.
     """
     return Number(value, Kind.UPPER, fmt)
+
+
+def at_most(value: float, fmt: str = ".3g") -> Number:
+    """A bound from above that holds to the accuracy of the computation behind it (an
+    integration's tolerance, the largest value over a run, a tolerance the book sets), not
+    certified: rounded up, so that "at most", "within" or "up to" before it stays true.
+
+    A value at round-off scale is not printed; the bound its method guarantees is, with the method
+    named beside it (``at_most(rtol * scale)``, well above the round-off).
+
+    Parameters
+    ----------
+    value : float
+        The unrounded value.
+    fmt : str
+        Its format spec ('.4f', '.2e', '.3g').
+
+    Returns
+    -------
+    Number
+        The number with its kind.
+    """
+    return Number(value, Kind.CEILING, fmt)
+
+
+def at_least(value: float, fmt: str = ".3g") -> Number:
+    """A bound from below that holds to the accuracy of the computation behind it, not
+    certified: rounded down, so that "at least" or "above" before it stays true.
+
+    Parameters
+    ----------
+    value : float
+        The unrounded value.
+    fmt : str
+        Its format spec ('.4f', '.2e', '.3g').
+
+    Returns
+    -------
+    Number
+        The number with its kind.
+    """
+    return Number(value, Kind.FLOOR, fmt)
+
+
+def within_accuracy(measured: float, accuracy: float, fmt: str = ".0e") -> Number:
+    """The bound ``accuracy`` that a method guarantees (an integrator's or Newton's tolerance, scaled
+    as the page states), printed in place of a ``measured`` value at round-off scale: "the run ends
+    within 2e-09 rad of p_s (ten times the integrator's tolerance)", never "within 5e-14", the last
+    bits of one machine, which another CPU rounds the other way.
+
+    Parameters
+    ----------
+    measured : float
+        What the computation gave (a distance, a difference), in the unit of ``accuracy``.
+    accuracy : float
+        The bound the method guarantees; at least ten times ``|measured|``, so that it holds on
+        another CPU, libm or BLAS with that margin.
+    fmt : str
+        Its format spec (default one significant digit, '.0e').
+
+    Returns
+    -------
+    Number
+        ``accuracy`` as an :func:`at_most` bound, rounded up.
+
+    Raises
+    ------
+    ValueError
+        When ``measured`` is not finite, or lies less than ten times below ``accuracy``: then the
+        measurement is not round-off, and the bound does not hold with a margin.
+    """
+    if isinstance(measured, bool) or not isinstance(measured, (int, float)) or not math.isfinite(measured):
+        raise ValueError(f"measured: a finite number, got {measured!r}")
+    if isinstance(accuracy, bool) or not isinstance(accuracy, (int, float)) or not accuracy > 0:
+        raise ValueError(f"accuracy: a positive number, got {accuracy!r}")
+    if not 10 * abs(measured) <= accuracy:
+        raise ValueError(f"accuracy: {accuracy!r} is less than ten times the measured {measured!r}: "
+                         "the measurement is not round-off, or the method's bound is not the one stated")
+    return at_most(float(accuracy), fmt)
+
+
+def setting(value: float, fmt: str = ".3g") -> Number:
+    """A value the book chooses (a tolerance, a horizon), written exactly as the code uses it.
+
+    Parameters
+    ----------
+    value : float
+        The setting.
+    fmt : str
+        A format spec that writes it exactly ('.0e' for 1e-10, '.2f' for 0.05); refused otherwise.
+
+    Returns
+    -------
+    Number
+        The number with its kind.
+    """
+    return Number(value, Kind.SETTING, fmt)
 
 
 def best_found(value: float, fmt: str = ".3g") -> Number:

@@ -23,7 +23,8 @@ from ..params import Body, Gains
 from ..percussion import percussion_fig5_map
 from ..rotation.circle_global import bistable_window
 from ..rotation.fig5 import fig5_map
-from ..machinery.kinds import Number, best_found, upper_bound
+from ..machinery.kinds import Number, best_found, upper_bound, within_accuracy
+from ..integrators.smooth import Integration
 from ..optimal.margins import SECOND_EIGHT
 from ..simulate import OPEN_LOOP_HORIZON
 from ..trajectories import eight
@@ -145,7 +146,10 @@ def front_page() -> dict[str, float | Number]:
         glue name -> value, in the unit :data:`LABELS` gives it.
     """
     f = findings()
-    pos, heading = open_loop_gap()
+    pos, heading, heading_scale = open_loop_gap()
+    # the headings differ by round-off (the wrong row does not enter the rotation): printed as the
+    # run's accuracy at the heading's scale (Methods, "What a computed number is accurate to")
+    heading = within_accuracy(heading, Integration().accuracy(heading_scale))
     gap = mirror_gap()
     free, capped = _angle_sweep(None), _angle_sweep(PAPER_CAP)
     lo, hi = cached(bistable_window, Body(), THETA0)                       # Chapter 5's call

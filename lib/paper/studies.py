@@ -280,16 +280,17 @@ def open_loop_deviations() -> dict[str, float]:
     return {k: float(np.abs(runs[k] - runs["config"]).max()) for k in ("state", "printed")}
 
 
-def open_loop_gap() -> tuple[float, float]:
+def open_loop_gap() -> tuple[float, float, float]:
     """Distance (m) of the printed drift's centre of mass from the true one, and their headings'
     difference (rad), at the end of Chapter 1's open-loop run (the front page and the report
-    quote both).
+    quote both), with the heading's scale, for the run's accuracy.
 
     Returns
     -------
     tuple of float
-        (distance in m, heading difference in rad modulo 2 pi).
+        (distance in m, heading difference in rad modulo 2 pi, largest |phi| of the true run in rad).
     """
     _, runs = open_loop_comparison(Body(), OPEN_LOOP_HORIZON)
     d = runs["printed"][-1] - runs["config"][-1]
-    return float(np.hypot(d[0], d[1])), float(abs(np.angle(np.exp(1j * d[2]))))
+    return (float(np.hypot(d[0], d[1])), float(abs(np.angle(np.exp(1j * d[2])))),
+            float(np.abs(runs["config"][:, 2]).max()))
