@@ -222,6 +222,7 @@ def test_a_round_off_value_is_printed_as_its_methods_bound_ten_times_above_it():
 
 def test_a_setting_is_written_exactly_or_refused():
     assert kinds.setting(1e-10, ".0e").text() == "1e-10" and kinds.setting(0.05, ".2f").text() == "0.05"
+    assert kinds.setting(0.1 * 1e-3, ".1g").text() == "0.0001"          # a product's last bit aside
     with pytest.raises(ValueError, match="exactly"):
         kinds.setting(0.05, ".1f")
 

@@ -157,7 +157,9 @@ class Number:
             object.__setattr__(self, "value", float(self.value))
             if self.total is not None:
                 raise ValueError(f"total: only a count has a total, not a {kind.value}")
-            if kind is Kind.SETTING and Decimal(self.text()) != Decimal(repr(self.value)):
+            # a setting computed as a product (0.1 * 1e-3) differs from its decimal in the last bit only
+            if kind is Kind.SETTING and abs(Decimal(self.text()) - Decimal(repr(self.value))) > \
+                    Decimal(1e-12) * abs(Decimal(repr(self.value))):
                 raise ValueError(f"fmt: a setting is written exactly, but {self.fmt!r} writes "
                                  f"{self.value!r} as {self.text()!r}")
         if (kind is Kind.ESTIMATE) != (self.stderr is not None):
