@@ -61,11 +61,12 @@ class Kind(str, Enum):
                 Kind.FLOOR: "down"}.get(self, "nearest")
 
 
-#: the kinds that bound a quantity from one side: a number after "within", "at most", "at least",
-#: "below", "above" or "up to" is one of these (or a count), so that the sentence holds on any CPU
+#: the kinds that bound a quantity from one side. A number after "within", "at most", "at least",
+#: "below", "above" or "up to" is one of these (or a count or a setting), so that the sentence
+#: holds on any CPU
 BOUNDS = (Kind.LOWER, Kind.UPPER, Kind.FOUND, Kind.CEILING, Kind.FLOOR)
 #: below this magnitude a computed value of the book's quantities (of order 1 in SI units) is at
-#: round-off scale: its digits are one machine's last bits, so it is never printed as measured
+#: round-off scale. Its digits are one machine's last bits, so it is never printed as measured
 #: (:func:`within_accuracy` prints the bound its method guarantees instead)
 ROUNDOFF = 1e-9
 
