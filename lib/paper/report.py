@@ -193,8 +193,8 @@ def _check_conclusion() -> Outcome:
 def _check_count() -> Outcome:
     printed, true = paper_bracket_count(2, 2), free_lie_rank(["f", "g1", "g2"], 2)
     return _corrected_by("sec3-bracket-count", float(printed - true), "printed count minus independent brackets "
-                         "(w = 2, r = 2)", "the count of bracket expressions, exactly; read as independent ones it "
-                         "over-counts from r = 2 on: a reading that changes no computation (see the errata row)")
+                         "(w = 2, r = 2)", "w(w+1)^r/2 counts the bracket expressions exactly; read as independent brackets "
+                         "it over-counts from r = 2 on: a reading that changes no computation (see the errata row)")
 
 
 # ------------------------------------------------------------------ Secs. 4-5, figures
