@@ -105,26 +105,29 @@ def test_slips_of_notation_and_readings_make_no_row_corrected():
 
 def test_each_word_of_the_legend_names_the_rows_the_referee_named():
     by_key = {i.key: i for i in ITEMS}
-    # Chow is true as printed; "theory 7" in the conclusion is a mis-citation of Theorem 6, whose
-    # inference (accessibility with drift gives STLC) is refuted in Theorem 6's row
-    assert by_key["thm7"].expected == "reproduced"
+    # "theory 7" read as printed: Chow's theorem (true, for systems without drift) cited for (5),
+    # which has a drift; read as a slip for Theorem 6, the inference is refuted in Theorem 6's row
+    assert by_key["thm7"].expected == "misapplied"
     assert by_key["thm6"].expected == by_key["gas"].expected == "refuted"
     assert by_key["quasi"].expected == "reproduced under an added condition"   # only with a force cap
     assert by_key["fig5"].expected == "not reproducible as stated"          # grid and criterion unstated
     assert by_key["fig5-map"].expected == "extended"                        # and the book's map beside it
-    # no row is "misapplied" since Theorem 7's citation was decided a slip for Theorem 6; the word
-    # stays in the legend, with its own falsifying test
-    assert {i.expected for i in ITEMS} == set(STATUSES) - {"not reproducible", "misapplied"}
+    assert by_key["fourier"].expected == "corrected"       # a wrong printed digit is not a slip of notation
+    assert by_key["count"].expected == "reproduced"        # the count of expressions: a reading
+    assert {i.expected for i in ITEMS} == set(STATUSES) - {"not reproducible"}
 
 
 def test_the_errata_rows_say_what_the_report_rows_say():
-    """The errata agree with the report's words: Theorem 7's row calls "theory 7" a mis-citation of
-    Theorem 6 that changes no computation, and the rows
-    behind the reproduced (23)-(24) and (27)-(28) say that they change no computation."""
+    """The errata agree with the report's words: Theorem 7's row says that it holds for systems
+    without drift only and is not a reading (the report's row is misapplied), a3's is a wrong value,
+    and the rows behind the reproduced (23)-(24) and (27)-(28) say that they change no computation."""
     by_key = {r.key: r for r in errata.rows()}
-    assert by_key["thm7-drift"].corrected.startswith("a mis-citation of Theorem 6") and by_key["thm7-drift"].notation
+    assert by_key["thm7-drift"].corrected.startswith("Theorem 7 (Chow) holds for systems without drift only")
+    assert not by_key["thm7-drift"].notation and not by_key["fourier-a3"].notation
+    assert by_key["sec3-bracket-count"].notation
     assert "No printed form fails" in by_key["eq24-rows"].corrected
     assert "slip of notation" in by_key["eq28-arg-branch"].corrected
     kinds = errata.table(run_checks=False).set_index("key")["kind"]
     assert kinds["eq24-rows"] == kinds["eq28-arg-branch"] == "notation or reading"
-    assert kinds["thm7-drift"] == "notation or reading"
+    assert kinds["sec3-bracket-count"] == "notation or reading"
+    assert kinds["thm7-drift"] == kinds["fourier-a3"] != "notation or reading"

@@ -31,14 +31,14 @@ from ..trajectories import eight
 from . import studies
 from .extensions import R0, THETA0, fig5_readings, mirror_gap
 from .outcomes import Outcome
-from .report import SWEEP_DEG, _angle_sweep, outcome
+from .report import SWEEP_DEG, _angle_sweep, outcome, status
 from .studies import open_loop_gap
 
-__all__ = ["FINDINGS", "LABELS", "findings", "front_page"]
+__all__ = ["FINDINGS", "LABELS", "WHAT_WE_FOUND", "findings", "front_page", "what_we_found"]
 
 #: the report rows the front page states, each with the status it states
 FINDINGS = {
-    "eq6": "corrected", "thm6": "refuted", "thm7": "reproduced", "stlc": "refuted", "gas": "refuted",
+    "eq6": "corrected", "thm6": "refuted", "thm7": "misapplied", "stlc": "refuted", "gas": "refuted",
     "window": "extended", "fig3": "reproduced", "limit-mirror": "extended", "chaos": "reproduced",
     "quasi": "reproduced under an added condition", "fig5": "not reproducible as stated", "fig5-map": "extended",
     "weight-limit": "extended", "percussion-map": "extended", "cap-bound": "extended", "second-eight": "extended",
@@ -112,6 +112,49 @@ LABELS = {
     },
 }
 
+
+#: for each chapter, the bullets of its "What we found" whose status word is glued: glue name -> the
+#: report rows (lib.paper.report) the bullet states, which share one status. Every report row of the
+#: page is in one bullet (``tests/test_status_words.py``). Chapters 4, 5 and 8 type their words still:
+#: Chapter 4's Fig. 4 row reads Chapter 8's computation, which Chapter 4 would then wait for
+WHAT_WE_FOUND = {
+    "chapters/02_controllability": {
+        "found_eq21_rank": ("eq21", "rank"), "found_count": ("count",), "found_thm6_stlc": ("thm6", "stlc"),
+        "found_thm7": ("thm7",),
+    },
+    "chapters/01_model": {"found_eq2_10": ("eq2-4", "eq5-10"), "found_eq6": ("eq6",)},
+    "chapters/03_tracking": {
+        "found_tracking": ("eq23-24", "eq25-26", "eq27-28", "eq29-30", "eq31", "fig2", "fig3"),
+        "found_table": ("table",), "found_wrong_model": ("wrong-model",),
+    },
+    "chapters/06_allocation": {"found_sec4_open": ("sec4-open",), "found_weight_limit": ("weight-limit",)},
+    "chapters/07_percussion": {"found_percussion": ("percussion-circle", "percussion-map")},
+}
+
+
+def what_we_found(page: str) -> dict[str, str]:
+    """The status words that head the bullets of ``page``'s "What we found", by glue name
+    (:data:`WHAT_WE_FOUND`): each is :func:`lib.paper.report.status` of the bullet's rows, the word
+    the report's rows print, capitalised.
+
+    Parameters
+    ----------
+    page : str
+        A chapter's document path, such as ``chapters/02_controllability``.
+
+    Returns
+    -------
+    dict
+        glue name -> status word ("Corrected", "Misapplied", ...).
+
+    Raises
+    ------
+    ValueError
+        If ``page`` has no bullets in :data:`WHAT_WE_FOUND`, or a bullet's rows disagree.
+    """
+    if page not in WHAT_WE_FOUND:
+        raise ValueError(f"page must be one of {sorted(WHAT_WE_FOUND)}, got {page!r}")
+    return {name: status(*keys).capitalize() for name, keys in WHAT_WE_FOUND[page].items()}
 
 def findings() -> dict[str, Outcome]:
     """The outcome of each row of :data:`FINDINGS`, by key: its figure of merit (``merit``, the

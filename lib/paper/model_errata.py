@@ -362,16 +362,15 @@ def _errata():
             printed="\"theory 7\" (a system *without drift* that is locally accessible is globally "
                     "controllable), cited to conclude that (5), a system *with* drift, is small-time locally "
                     "controllable",
-            corrected="a mis-citation of Theorem 6: the sentence draws Theorem 6's conclusion (STLC) for a system "
-                      "with drift, which is Theorem 6's hypothesis; Theorem 7 (Chow) concludes global "
-                      "controllability for systems without drift, which the paper never claims, and it cannot "
-                      "give that inference ($\\dot x_1 = u$, $\\dot x_2 = x_1^2$ has a drift, is accessible at "
-                      "0 and never lowers $x_2$). The inference is Theorem 6's, refuted in its row",
+            corrected="Theorem 7 (Chow) holds for systems without drift only; (5) has a drift, nonzero at "
+                      "every moving state, so Theorem 7 cannot give the conclusion, and accessibility with a "
+                      "drift does not give STLC ($\\dot x_1 = u$, $\\dot x_2 = x_1^2$ has a drift, is accessible "
+                      "at 0 and never lowers $x_2$). Read as a slip for Theorem 6, the inference is Theorem 6's, "
+                      "refuted in its row",
             verified_by="the counterexample and a driftless system checked with `accessibility_matrix`; "
                         "the body's drift at a moving state (`lib.paper.model_errata._check_theorem7`)",
             section="chapters/02_controllability",
-            check=_check_theorem7,
-            notation=True,        # a citation: the inference it names is Theorem 6's, whose row decides it
+            check=_check_theorem7,     # a theorem cited outside its hypothesis: the report's row is misapplied
         ),
         Erratum(
             key="sec3-stlc-conclusion",

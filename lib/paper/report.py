@@ -1,17 +1,15 @@
 """Reproduction report: one row per equation, claim and figure of the paper.
 
-Each :class:`Item` carries a ``check`` that recomputes the evidence and returns
-an :class:`Outcome` whose ``status`` is decided by the computation (a residual
-under a tolerance, an errata row confirmed, ...), with a figure of merit. The
-report page renders the outcomes; the test suite runs every check and asserts
-that the computed status is the one the book reports (``Item.expected``), so a
-regression changes the page and fails the tests.
+Each :class:`Item` carries a ``check`` that recomputes the evidence and returns an
+:class:`Outcome` whose ``status`` is decided by the computation (a residual under a tolerance, an
+errata row confirmed, ...), with a figure of merit. The report page and each chapter's "What we
+found" read the status through one function, :func:`status`; the test suite runs every check and
+asserts that the computed status is the one the book reports (``Item.expected``).
 
 The statuses (:data:`STATUSES`) and the rule that gives them are
 :func:`lib.paper.outcomes.legend_status` (a confirmed errata row on a row's equations,
 :func:`errata_on`, not a reading or a slip of notation, makes it "corrected"). A check decides
-between the status the legend gives its item and ``not reproducible``; the test suite asserts
-that it decides the claimed one and that the claimed one is the legend's.
+between the status the legend gives its item and ``not reproducible``.
 """
 
 from __future__ import annotations
@@ -27,8 +25,7 @@ from scipy.optimize import brentq, minimize_scalar
 from ..rotation.circle import (circle_critical_radius, circle_eigenvalues, circle_equilibria,
                                circle_jacobian, circle_rotation_rhs)
 from ..rotation.circle_global import circle_slipping_coexists
-from ..allocation import allocate_limited
-from ..control import allocate, allocate_least_squares, error_dynamics_solution
+from ..control import allocate, error_dynamics_solution
 from ..controllability import free_lie_rank, paper_bracket_count
 from ..limits.torus import NS_ANGLE_DEG, NS_START_CAP
 from ..limits.verdicts import extend_undecided, limit_verdicts
@@ -40,17 +37,18 @@ from ..rotation.equations import derive_rotation_equation
 from ..simulate import OPEN_LOOP_HORIZON
 from ..symbolic import derive_body_frame, rank_determinants
 from ..tracking.runs import steady_summary
-from ..trajectories import circle, eight, eight_heading_fourier
+from ..trajectories import PAPER_HEADING_SERIES, circle, eight, eight_heading_fourier
 from ..machinery.cache import cached
-from ..machinery.kinds import Kind
+from ..machinery.kinds import Kind, exact
 from ..optimal.bound import exact_peak_force
 from .errata import rows, verdict
-from .extensions import fig5_readings, items as extension_items
+from .extensions import check_open_problem, fig5_readings, items as extension_items
 from . import studies
 from .studies import FIG4_CAP, R0, THETA0
 from .outcomes import STATUSES, Item, Outcome, legend_status
 
-__all__ = ["Outcome", "Item", "items", "outcome", "table", "STATUSES", "equation_numbers", "errata_on"]
+__all__ = ["Outcome", "Item", "items", "outcome", "status", "table", "STATUSES", "equation_numbers",
+           "errata_on"]
 
 
 def equation_numbers(text: str) -> set[int]:
@@ -138,33 +136,6 @@ def _check_limits_29_30() -> Outcome:
     return Outcome(legend_status(final < 1e-6), final, "max |e_x|, |e_y| at t = 60 s (m), circle")
 
 
-def _check_open_problem() -> Outcome:
-    # the closed-form optimum without limits, and the exact optimum under a force cap and an
-    # angle limit beyond pi/2 (a non-convex sector), each against a grid search
-    body = Body()
-    rng = np.random.default_rng(7)
-    tau, phi = rng.normal(scale=3.0, size=(200, 3)), rng.uniform(-np.pi, np.pi, 200)
-    w = np.array([1.0, 1.0, 1.0])
-    F, beta = allocate_least_squares(tau, phi, body, tuple(w))
-    cost = lambda F, b: np.sum(w * (tau - generalized_force(F, b, phi) * [1, 1, body.a]) ** 2, -1)  # noqa: E731
-    Fg = np.linspace(0.0, 20.0, 201)
-    bg = np.linspace(-np.pi, np.pi, 361)
-    grid = np.min([cost(np.full(200, f), np.full(200, b)) for f in Fg for b in bg[::4]], axis=0)
-    gap = float(np.max(cost(F, beta) - grid))
-    fmax, bmax = 2.5, 2.2
-    Fl, bl = allocate_limited(tau, phi, body, tuple(w), fmax, bmax)
-    feasible = bool(np.all(Fl <= fmax * (1 + 1e-12)) and np.all(np.abs(bl) <= bmax * (1 + 1e-12)))
-    grid_l = np.min([cost(np.full(200, f), np.full(200, b)) for f in np.linspace(0.0, fmax, 101)
-                     for b in np.linspace(-bmax, bmax, 221)], axis=0)
-    gap_l = float(np.max(cost(Fl, bl) - grid_l))
-    worst = max(gap, gap_l)
-    return Outcome(legend_status(worst <= 1e-12 and feasible, extension=True), worst,
-                   "max (exact cost - grid-search cost), 200 random demands, without limits and with F <= 2.5 N, "
-                   "|beta| <= 2.2 rad (<= 0: never worse)",
-                   "closed-form weighted least-squares allocation, and its exact solution under the limits "
-                   "(also for a non-convex sector), Chapter 6")
-
-
 # ------------------------------------------------------------------ Sec. 3
 
 def _corrected_group(prefix: str, merit_label: str) -> Outcome:
@@ -197,14 +168,20 @@ def _check_thm6() -> Outcome:
 
 
 def _check_thm7() -> Outcome:
-    # "theory 7" is a mis-citation of Theorem 6 (its conclusion, STLC with drift); Chow holds as printed
+    # the book reads "theory 7" as printed: Theorem 7 (Chow), whose hypothesis is a system without
+    # drift, cited for (5), whose drift is not zero at a moving state. A true theorem outside its
+    # hypotheses: misapplied, and the counterexample of the errata row shows that the inference
+    # (accessible with a drift, so STLC) fails
     drift = float(np.linalg.norm(f(Body(), np.array([0.0, 0.0, 0.3, 1.0, 0.5, 0.2]))))
     v = verdict("thm7-drift")
-    return Outcome(legend_status(drift > 0 and v.confirmed), drift,
-                   "|f(q)| at a moving state: the drift is not zero, so only Theorem 6 could give the inference",
-                   "Theorem 7 (Chow) holds as printed, for systems without drift; the paper's \"theory 7\" draws "
-                   "Theorem 6's conclusion (STLC) for (5), which has a drift: a mis-citation of Theorem 6, whose "
-                   "row is refuted", erratum="thm7-drift")
+    outside = drift > 0
+    return Outcome(legend_status(outside and v.confirmed, misapplied=outside, counterexample=True), drift,
+                   "|f(q)| at a moving state: the drift of (5) is not zero, so Theorem 7 (systems without drift) "
+                   "does not apply",
+                   "Theorem 7 (Chow) holds as printed, for systems without drift; the conclusion of Sec. 3 cites it "
+                   "(\"theory 7\") for (5), which has a drift, to conclude STLC: outside its hypothesis, the "
+                   "conclusion does not follow from it. Read instead as a slip for Theorem 6, the inference is "
+                   "Theorem 6's, refuted in its row", erratum="thm7-drift", counterexample=True, misapplied=outside)
 
 
 def _check_conclusion() -> Outcome:
@@ -215,8 +192,9 @@ def _check_conclusion() -> Outcome:
 
 def _check_count() -> Outcome:
     printed, true = paper_bracket_count(2, 2), free_lie_rank(["f", "g1", "g2"], 2)
-    return _corrected_by("sec3-bracket-count", float(printed - true),
-                         "printed count minus independent brackets (w = 2, r = 2)")
+    return _corrected_by("sec3-bracket-count", float(printed - true), "printed count minus independent brackets "
+                         "(w = 2, r = 2)", "w(w+1)^r/2 counts the bracket expressions exactly; read as independent brackets "
+                         "it over-counts from r = 2 on: a reading that changes no computation (see the errata row)")
 
 
 # ------------------------------------------------------------------ Secs. 4-5, figures
@@ -398,10 +376,16 @@ def _check_eq37() -> Outcome:
 
 
 def _check_fourier() -> Outcome:
-    a = eight_heading_fourier(3)
-    return _corrected_by("fourier-a3", float(a[3]), "computed a3 (rad); printed -0.24",
-                         "a1 and a5 are the computed ones rounded; a3 rounds to -0.23, not -0.24: a slip in a "
-                         "series the paper computes nothing with")
+    # every number of the row is a computed coefficient or the paper's printed one, none typed: a_k
+    # (FFT, converged to round-off in its samples: exact) to four decimals and to the printed two
+    a, printed = eight_heading_fourier(5), PAPER_HEADING_SERIES
+    txt = lambda x, fmt=".2f": exact(float(x), fmt).text()       # noqa: E731  rounded to nearest
+    agree = [k for k in (1, 3, 5) if txt(a[k]) == txt(printed[k])]
+    note = (", ".join(f"a{k}" for k in agree) + " are the computed ones rounded to the printed two decimals; "
+            + "; ".join(f"a{k} = {txt(a[k], '.4f')} rounds to {txt(a[k])}, the paper prints {txt(printed[k])}"
+                        for k in (1, 3, 5) if k not in agree) + " (see the errata row)")
+    out = _corrected_by("fourier-a3", float(a[3]), f"computed a3 (rad); the paper prints {txt(printed[3])}", note)
+    return Outcome(out.status, out.merit, out.merit_label, out.note, erratum=out.erratum, merit_fmt=".4f")
 
 
 def _check_fig5() -> Outcome:
@@ -435,7 +419,7 @@ def items() -> list[Item]:
           "reproduced", _check_count),
         I("thm6", "Theorem 6: accessibility implies STLC", "chapters/02_controllability", "refuted", _check_thm6),
         I("thm7", "Theorem 7, and \"theory 7\" in the conclusion of Sec. 3", "chapters/02_controllability",
-          "reproduced", _check_thm7),
+          "misapplied", _check_thm7),
         I("stlc", "Sec. 3 conclusion: STLC off the exceptional set", "chapters/02_controllability", "refuted",
           _check_conclusion),
         I("eq23-24", "Eqs. (23)-(24): computed torque and the error equation", "chapters/03_tracking",
@@ -443,7 +427,7 @@ def items() -> list[Item]:
         I("eq25-26", "Eqs. (25)-(26): position-only allocation", "chapters/03_tracking", "reproduced",
           _check_allocation),
         I("sec4-open", "Sec. 4: the allocation min ||tau - Q||^2 (left unsolved)", "chapters/06_allocation",
-          "extended", _check_open_problem),
+          "extended", check_open_problem),
         I("eq27-28", "Eqs. (27)-(28): circle and eight references", "chapters/03_tracking", "reproduced",
           _check_eq27_28),
         I("eq29-30", "Eqs. (29)-(30): position errors vanish", "chapters/03_tracking", "reproduced",
@@ -467,7 +451,7 @@ def items() -> list[Item]:
         I("gas", "Sec. 6: rotation error globally asymptotically stable under (36)", "chapters/05_stability",
           "refuted", _check_gas),
         I("eq37", "Eq. (37): rotation on the eight", "chapters/05_stability", "corrected", _check_eq37),
-        I("fourier", "Sec. 6: 3-term series of the eight's tangent angle", "chapters/05_stability", "reproduced",
+        I("fourier", "Sec. 6: 3-term series of the eight's tangent angle", "chapters/05_stability", "corrected",
           _check_fourier),
         I("fig5", "Fig. 5: rotation-error range over (R, Theta)", "chapters/05_stability",
           "not reproducible as stated", _check_fig5),
@@ -488,13 +472,26 @@ def _check_item(key: str) -> Outcome:
     raise KeyError(f"no report row {key!r}")
 
 
+def status(*keys: str) -> str:
+    """The status word of the report rows ``keys``: the one source of it for the report's rows
+    (:func:`table`) and for each chapter's "What we found" (:func:`lib.paper.findings.what_we_found`),
+    so that the two cannot disagree. The rows a bullet states together must share it.
+
+    Raises ValueError if ``keys`` is empty or its rows' statuses differ, KeyError for a key that is
+    not a report row."""
+    words = {k: outcome(k).status for k in keys}
+    if len(set(words.values())) != 1:
+        raise ValueError(f"keys: one status is needed, the rows give {words or 'none (no keys)'}")
+    return words[keys[0]]
+
+
 def table():
-    """Run every check; the report as a pandas DataFrame."""
+    """Run every check; the report as a pandas DataFrame (its ``status`` column is :func:`status`)."""
     records = []
     for it in items():
         out = outcome(it.key)
         records.append({"key": it.key, "paper": it.paper, "section": it.section, "expected": it.expected,
-                        "status": out.status, "merit": out.merit, "merit_kind": out.merit_kind,
+                        "status": status(it.key), "merit": out.merit, "merit_kind": out.merit_kind,
                         "merit_text": out.merit_text(), "merit_label": out.merit_label,
                         "note": out.note, "erratum": out.erratum})
     return pd.DataFrame.from_records(records)

@@ -191,8 +191,9 @@ def _errata():
             verified_by="FFT of the continuous tangent angle (`lib.stability.eight_heading_fourier`), "
                         "compared with the printed digits as whole hundredths "
                         "(`lib.paper.rotation_errata._check_fourier_digits`)",
-            section=sec, check=_check_fourier_digits,
-            notation=True),       # the paper computes nothing with the series: a slip that changes no result
+            # a wrong printed value, neither a slip of notation nor a reading (not ``notation``): the
+            # paper computes nothing with the series, but "reproduced" would say it holds as printed
+            section=sec, check=_check_fourier_digits),
     ]
 
 
