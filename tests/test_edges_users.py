@@ -146,3 +146,11 @@ def test_a_bad_force_limit_is_named_by_its_argument_and_index():
              r"^force_limits must be positive \(N\), or inf or None for no force limit, got -1\.0$")
     _refused(lambda: limit_verdicts(B, G, T.eight(), [1.0, 1.0], force_limits=[2.0, -1.0]),
              r"^force_limits\[1\] must be positive")
+
+
+def test_an_unknown_integration_method_is_refused_naming_the_methods_before_any_run():
+    # issue 59: Integration(method="Foo") was accepted, and simulate then raised scipy's own message
+    msg = _refused(lambda: Integration(method="Foo"), r"Integration\.method")
+    assert "'Foo'" in msg and "DOP853" in msg and "Radau" in msg
+    assert Integration(method="Radau").method == "Radau"
+

@@ -27,6 +27,10 @@ class SimulationError(RuntimeError):
     """The integration failed or the solution became non-finite or blew up."""
 
 
+#: the methods of :func:`scipy.integrate.solve_ivp`, by the names it documents
+METHODS = ("BDF", "DOP853", "LSODA", "RK23", "RK45", "Radau")
+
+
 @dataclass(frozen=True)
 class Integration:
     """How to integrate: ``method`` of :func:`scipy.integrate.solve_ivp`, relative and
@@ -70,6 +74,9 @@ class Integration:
                 raise ValueError(f"Integration.{name} must be a positive number, got {v!r}")
         if self.switching not in SWITCHING:
             raise ValueError(f"switching must be one of {SWITCHING}, got {self.switching!r}")
+        if self.method not in METHODS:
+            raise ValueError(f"Integration.method must be one of scipy's solve_ivp methods {METHODS}, "
+                             f"got {self.method!r}")
 
 
 def integrate(rhs: Callable, s0, t_end: float, t_eval, integration: Integration,
