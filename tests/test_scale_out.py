@@ -191,7 +191,7 @@ from lib.machinery.parallel import map_in_processes
 """
 
 
-@pytest.mark.parametrize("guarded", [False, True, "nested", "not a guard"])
+@pytest.mark.parametrize("guarded", [False, True, "nested", "not a guard", "in a function", "function unguarded"])
 def test_worker_processes_from_an_unguarded_script_fail_at_once_naming_the_fix(tmp_path, guarded):
     # spawned workers import the script again: without the guard its body would run in each of
     # them and multiprocessing would print pages of "bootstrapping phase" tracebacks. A guard
@@ -201,14 +201,17 @@ def test_worker_processes_from_an_unguarded_script_fail_at_once_naming_the_fix(t
     call = "print(map_in_processes(math.sqrt, [1.0, 4.0, 9.0], workers=2))"
     body = {False: call, True: f'if __name__ == "__main__":\n    {call}',
             "nested": f'if math.pi > 3:\n    if __name__ == "__main__":\n        {call}',
-            "not a guard": f'if __name__ != "__main__" or math.pi > 3:\n    {call}'}[guarded]
+            "not a guard": f'if __name__ != "__main__" or math.pi > 3:\n    {call}',
+            # issue 59: a guard inside the function that a bare call at the top level runs
+            "in a function": f'def main():\n    if __name__ == "__main__":\n        {call}\nmain()',
+            "function unguarded": f'def main():\n    {call}\nmain()'}[guarded]
     script = tmp_path / "sweep.py"
     script.write_text(_SCRIPT.format(body=body))
     out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120)
-    if guarded in (True, "nested"):
+    if guarded in (True, "nested", "in a function"):
         assert out.returncode == 0 and out.stdout.strip() == "[1.0, 2.0, 3.0]", out.stderr
     else:
-        line = 4 if guarded is False else 5
+        line = {False: 4, "not a guard": 5, "function unguarded": 6}[guarded]       # the top-level line
         assert out.returncode != 0
         assert 'if __name__ == "__main__":' in out.stderr and f"sweep.py, line {line}" in out.stderr
         assert "bootstrapping" not in out.stderr and out.stderr.count("Traceback") == 1

@@ -140,16 +140,19 @@ def _refuse_unguarded_script() -> None:
     if not path:
         return
     path = os.path.realpath(path)
-    frame = sys._getframe(1)
+    frame, lines = sys._getframe(1), []
+    # the script's frames on the way up, innermost first: the call is guarded when any of them stands
+    # in a guard, a function's body included (def main(): if __name__ == "__main__": ...; main())
     while frame is not None:
-        if (frame.f_code.co_name == "<module>" and frame.f_globals.get("__name__") == "__main__"
-                and os.path.realpath(frame.f_code.co_filename) == path):
-            if _unguarded_line(path, frame.f_lineno):
-                raise RuntimeError(
-                    f"{path}, line {frame.f_lineno}: worker processes are spawned and import this script "
-                    "again, so a sweep with workers > 1 (or a process pool) must be called under "
-                    "`if __name__ == \"__main__\":`; put the script's work in that block, or use workers=1")
-            return
+        if frame.f_globals.get("__name__") == "__main__" and os.path.realpath(frame.f_code.co_filename) == path:
+            lines.append(frame.f_lineno)
+            if frame.f_code.co_name == "<module>":
+                if all(_unguarded_line(path, line) for line in lines):
+                    raise RuntimeError(
+                        f"{path}, line {frame.f_lineno}: worker processes are spawned and import this script "
+                        "again, so a sweep with workers > 1 (or a process pool) must be called under "
+                        "`if __name__ == \"__main__\":`; put the script's work in that block, or use workers=1")
+                return
         frame = frame.f_back
 
 
