@@ -25,7 +25,7 @@ only when run interactively: ``lib.machinery.parallel.show_progress``). Every pu
 its arguments with ``lib.machinery.checks``: a wrong type is a ``TypeError``, a wrong value a
 ``ValueError``, each naming the argument (and the index in an array).
 
-README.md's "Where to start in the library" runs a small Fig. 5 map and a capped circle;
+README.md's "Use the library" runs a small Fig. 5 map and a capped circle;
 the book's "Library reference" page (``reference.md``) is generated from the docstrings.
 """
 

@@ -83,7 +83,7 @@ def test_wheel_installs_every_module_of_lib_and_they_import_from_it(tmp_path):
     # the typing marker and the module map ship with the package; the licence and its name with the metadata
     assert (site / "lib" / "py.typed").is_file() and (site / "lib" / "README.md").is_file()
     (info,) = site.glob("korczak2014_lib-*.dist-info")
-    assert "License: MIT" in (info / "METADATA").read_text()
+    assert "License-Expression: MIT" in (info / "METADATA").read_text()          # PEP 639
     assert (info / "LICENSE").is_file() or any(info.glob("licenses/LICENSE"))
 
 
@@ -156,7 +156,7 @@ def test_citation_cff_cites_the_book_and_the_paper():
 
 def test_code_is_mit_and_text_cc_by_4():
     project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
-    assert project["license"] == {"text": "MIT"}
+    assert project["license"] == "MIT" and project["license-files"] == ["LICENSE"]      # PEP 639, not a table
     licence = (ROOT / "LICENSE").read_text()
     assert "MIT licence" in licence and "Permission is hereby granted, free of charge" in licence
     assert "Creative Commons Attribution 4.0 International" in licence

@@ -224,3 +224,21 @@ def test_one_page_mode_replaces_that_page_and_keeps_the_others(tmp_path):
     assert cache.match_cache_notebook(read_page(tmp_path / "a.md", tmp_path)).pk == a_before
     b = cache.get_cache_bundle(cache.match_cache_notebook(read_page(tmp_path / "b.md", tmp_path)).pk).nb
     assert "second b" in "".join(o.get("text", "") for c in b.cells for o in c.get("outputs", []))
+
+
+def test_the_sections_and_names_that_the_package_and_requirements_point_to_exist():
+    # issue 59: lib/__init__ named a README section that had been renamed, and requirements.txt a
+    # module that had moved (lib.parallel -> lib.machinery.parallel)
+    import importlib
+    import lib
+    headings = set(re.findall(r"^#+ (.+)$", (ROOT / "README.md").read_text(), flags=re.M))
+    named = re.findall(r'README\.md\'s "([^"]+)"', lib.__doc__)
+    assert named and set(named) <= headings, set(named) - headings
+    dotted = re.findall(r"\((lib(?:\.\w+)+)\)", (ROOT / "requirements.txt").read_text())
+    assert dotted
+    for name in dotted:                          # a module, or a name in one
+        module, _, attr = name.rpartition(".")
+        try:
+            importlib.import_module(name)
+        except ModuleNotFoundError:
+            assert hasattr(importlib.import_module(module), attr), name
