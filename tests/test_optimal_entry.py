@@ -67,6 +67,13 @@ def test_a_bad_entry_is_refused_naming_its_argument(capped30, kw, match):
         entry_motion(BODY, capped30, **kw)
 
 
+def test_an_entry_onto_a_motion_of_another_body_is_refused_as_the_tracker_refuses_it(capped30):
+    # issue 59: entry_motion(Body(m=3.0), a motion planned for Body()) planned without complaint, where
+    # track_motion and motion_verdict refuse the same pair
+    with pytest.raises(ValueError, match=r"motion is not a periodic motion of body = Body\(m=3.0"):
+        entry_motion(Body(m=3.0), capped30)
+
+
 def test_an_entry_onto_something_else_than_a_motion_is_refused():
     with pytest.raises(TypeError, match="motion"):
         entry_motion(BODY, object())

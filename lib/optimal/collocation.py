@@ -353,6 +353,8 @@ def entry_motion(body: Body, motion: PeriodicMotion, start=None, *, periods: int
     checks.instance("body", body, Body)
     if not all(hasattr(motion, k) for k in ("state", "inputs", "period", "turns", "F_max", "beta_max", "kind")):
         raise TypeError(f"motion must be a PeriodicMotion (lib.optimal.motion.periodic_motion), got {type(motion).__name__}")
+    from .tracker import _check_body           # here: the tracker imports the motion, which imports this module
+    _check_body(body, motion)                  # a motion of another body is refused, as track_motion refuses it
     x0 = checks.array("start", np.concatenate([PAPER_Z0, PAPER_DZ0]) if start is None else start, shape=(6,))
     periods = checks.integer("periods", periods, minimum=1)
     nodes = checks.integer("nodes", nodes, minimum=8)
