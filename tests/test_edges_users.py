@@ -154,3 +154,17 @@ def test_an_unknown_integration_method_is_refused_naming_the_methods_before_any_
     assert "'Foo'" in msg and "DOP853" in msg and "Radau" in msg
     assert Integration(method="Radau").method == "Radau"
 
+
+
+@pytest.mark.parametrize("call, option", [
+    (lambda g: limit_verdicts(B, g, T.eight(), [1.0]), "steps_per_period"),
+    (lambda g: __import__("lib.tracking.runs", fromlist=["x"]).force_cap_sweep(B, g, T.eight(), [4.0]),
+     "samples_per_period"),
+    (lambda g: closed_loop_verdicts(B, g, "eight", [2.0], [np.pi / 4]), "steps"),
+])
+def test_gains_too_stiff_for_a_runs_fixed_steps_are_refused_at_once_naming_the_gains(call, option):
+    # issue 59: limit_verdicts with kp = 1e6 ran 58 s, then said "the state became non-finite"
+    # without naming the gains, and force_cap_sweep ran silently; each now refuses before any run
+    msg = _refused(lambda: call(Gains(kp=1e6)), r"^gains: ")
+    assert re.search(rf"raise (the option )?{option} to \d+", msg), msg
+    assert not re.search("non-finite", msg)

@@ -105,13 +105,16 @@ def _limits_arrays(angle_limits, force_limits):
     return b.copy(), f.copy()
 
 
-def _check_parts(body, gains, ref) -> None:
-    """The body, gains and reference of a switched run (TypeError naming a wrong one)."""
+def _check_parts(body, gains, ref, steps: int | None = None, option: str = "steps_per_period") -> None:
+    """The body, gains and reference of a switched run (TypeError naming a wrong one), and the run's
+    domain: with ``steps``, the fixed steps a period it takes (``option``) must follow its fastest mode,
+    or stiff gains are refused at once, naming the gains (issue 59), instead of a run that diverges."""
     checks.instance("body", body, Body)
     checks.instance("gains", gains, Gains)
     checks.instance("ref", ref, (Circle, Eight), "lib.trajectories.Circle or Eight")
     checks.loop_domain(body, gains, KINEMATICS["circle" if isinstance(ref, Circle) else "eight"], [ref.R],
-                       [ref.theta], heading_gains=False, names=("ref.R", "ref.theta"))   # before any run (issue 37)
+                       [ref.theta], heading_gains=False, names=("ref.R", "ref.theta"), steps=steps,
+                       option=option)   # before any run (issue 37)
 
 
 def _start_states(s0, n: int) -> np.ndarray:
@@ -194,13 +197,13 @@ def switched_runs(body: Body, gains: Gains, ref: Reference, angle_limits, force_
         The limits, the sample times, the recorded states and errors, the final modes, the
     companion's log-growths and the event statistics (crossings, slides, time sliding).
     """
-    _check_parts(body, gains, ref)
+    steps_per_period = checks.integer("steps_per_period", steps_per_period, minimum=16)
+    _check_parts(body, gains, ref, steps_per_period)
     b, f = _limits_arrays(angle_limits, force_limits)
     n_periods = checks.integer("n_periods", n_periods, minimum=1)
     lf = -1 if lyapunov_from is None else checks.integer("lyapunov_from", lyapunov_from)
     if lyapunov_from is not None and not 0 <= lf < n_periods - 1:
         raise ValueError(f"lyapunov_from must be in [0, n_periods - 1), got {lyapunov_from!r}")
-    steps_per_period = checks.integer("steps_per_period", steps_per_period, minimum=16)
     S = checks.integer("samples_per_period", samples_per_period, minimum=1)
     if steps_per_period % S:
         raise ValueError(f"samples_per_period must be a positive integer dividing steps_per_period "

@@ -173,7 +173,7 @@ def limit_verdicts(body: Body, gains: Gains, ref: Reference, angle_limits, force
         (:class:`SwitchedRuns`), the runs behind it, in the order of the pairs.
     """
     o, steps_per_period, locator = _procedure(options, steps_per_period, locator)
-    _check_parts(body, gains, ref)
+    _check_parts(body, gains, ref, steps_per_period)
     b, f = _limits_arrays(angle_limits, force_limits)
     S0 = _start_states(s0, b.size)
     measure = checks.flag("measure", measure)

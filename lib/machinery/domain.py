@@ -329,7 +329,8 @@ def steps_domain(steps, damping_steps, R, Theta) -> None:
                   fix="outside the verdicts' domain (R far beyond the body's scale, or Theta far below its rates)")
 
 
-def loop_domain(body, gains, kin, R, Theta, *, heading_gains: bool = True, names=("R", "Theta")) -> None:
+def loop_domain(body, gains, kin, R, Theta, *, heading_gains: bool = True, names=("R", "Theta"),
+                steps: int | None = None, option: str = "steps") -> None:
     """The domain of a sweep of the full closed loop over points (R_i (m), Theta_i (rad/s)) on the
     path ``kin`` (``kin(R, Theta, t)`` -> (z_d, dz_d, ddz_d), :data:`lib.trajectories.KINEMATICS`):
     the heading's damping time at most :data:`MAX_DAMPING_PERIODS` periods (``Theta``), and the
@@ -354,6 +355,12 @@ def loop_domain(body, gains, kin, R, Theta, *, heading_gains: bool = True, names
         Whether the allocation uses the heading's gains (w_phi > 0 somewhere).
     names : tuple of str
         How the caller names R and Theta (``("ref.R", "ref.theta")`` for a reference).
+    steps : int, optional
+        The fixed steps a period the caller will take: when given, the point must also fit them (a
+        run with fewer steps than its fastest mode needs diverges), and the message advises the
+        steps it needs.
+    option : str
+        How the caller names ``steps``, for that advice.
 
     Raises
     ------
@@ -376,6 +383,11 @@ def loop_domain(body, gains, kin, R, Theta, *, heading_gains: bool = True, names
                   values={names[0]: (R, "m"), names[1]: (Theta, "rad/s")},
                   fix="outside the sweep's domain (stiff gains, R far beyond the body's scale or Theta far "
                   "from its rates)")
+    if steps is not None:
+        most = int(np.ceil(max(np.max(v) for v in need.values())))
+        within_budget(need, steps, what="a period would need", unit=f"fixed steps (h |lambda| <= {RK4_REACH:g})",
+                      values={names[0]: (R, "m"), names[1]: (Theta, "rad/s")},
+                      fix=f"raise {option} to {most} ({option}={steps} given)")
 
 
 def path_budget(body, R, Theta, span, *, speed: float = 1.0, accel: float = 1.0, names=("R", "Theta"),

@@ -27,7 +27,7 @@ from .mismatch import mismatch_sweep
 from ..machinery.parallel import concat_frames, map_chunks, map_in_processes
 from ..params import Body, Gains
 from ..simulate import Integration, SimulationResult, simulate
-from ..trajectories import Reference, make
+from ..trajectories import KINEMATICS, Circle, Eight, Reference, make
 
 __all__ = [
     "run", "steady_mask", "restrict", "rotation_error_continuous", "position_deviation_from_eq24",
@@ -427,6 +427,11 @@ def force_cap_sweep(body: Body, gains: Gains, ref: Reference, caps, *, n_periods
         raise ValueError(f"need 0 < n_steady < n_periods, got {n_steady!r} and {n_periods!r}")
     checks.instance("body", body, Body)
     checks.instance("gains", gains, Gains)
+    checks.instance("ref", ref, (Circle, Eight), "lib.trajectories.Circle or Eight")
+    # its runs take samples_per_period fixed steps a period: stiff gains are refused here, naming them
+    checks.loop_domain(body, gains, KINEMATICS["circle" if isinstance(ref, Circle) else "eight"], [ref.R],
+                       [ref.theta], heading_gains=False, names=("ref.R", "ref.theta"), steps=samples_per_period,
+                       option="samples_per_period")
     parts = map_chunks(_cap_chunk, caps.size, (caps,), dict(body=body, gains=gains, ref=ref, n_periods=n_periods,
                        n_steady=n_steady, samples_per_period=samples_per_period), executor, chunk_size,
                        progress)
