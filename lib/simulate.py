@@ -3,17 +3,19 @@ allocation (by default the paper's position-only (25)-(26)) and optional limits.
 
 :func:`simulate` takes its options grouped: a :class:`lib.allocation.Limits`, a
 :class:`lib.allocation.Allocation` and an :class:`Integration`. With
-``Integration(switching="stepsize")`` (the default) the closed loop
+``Integration(switching="stepsize")`` the closed loop
 (:class:`lib.closed_loop.ClosedLoop`) is integrated by one adaptive ``solve_ivp``
 run (:mod:`lib.integrators.smooth`); with an angle limit the field is then only
-piecewise smooth and the step-size control resolves the switching, at some
-cost. ``Integration(switching="events")`` locates every crossing of the switching
-surface and slides along it (:mod:`lib.integrators.switched`).
+piecewise smooth and the step-size control resolves the switching, at a cost that
+grows without bound along a sliding motion. ``Integration(switching="events")``
+locates every crossing of the switching surface and slides along it
+(:mod:`lib.integrators.switched`); the default, ``"auto"``, takes it wherever it
+applies (an angle limit below pi on the position-only law, the plant its own model).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
@@ -191,7 +193,8 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
     (the m, I_C, c, c_phi, a of (23) and of the allocation; default None, the plant
     ``body`` itself); a model other than the plant needs ``switching="stepsize"``.
 
-    With ``Integration(switching="events")`` the angle limit's switching surface
+    With ``Integration(switching="events")``, and by default (``"auto"``) wherever it applies, the
+    angle limit's switching surface
     is located (:class:`lib.integrators.switched.SwitchedLoop`): it needs an angle
     limit below pi and the position-only law; in the result, ``beta`` while
     sliding is the Filippov average angle and ``mode`` records the side.
@@ -249,6 +252,10 @@ def simulate(body: Body, gains: Gains, ref: Reference, t_end: float, z0=None, dz
         checks.instance("model", model, Body, "lib.params.Body or None")
     _check_budget(body, gains, ref, t_end, integration, allocation)     # before the output times are built
     t_eval = default_times(t_end, t_eval)
+    if integration.switching == "auto":         # events wherever the event-located loop applies
+        events = (limits is not None and limits.angle is not None and limits.angle < np.pi
+                  and allocation.law == "position" and (model is None or model == body))
+        integration = replace(integration, switching="events" if events else "stepsize")
     if integration.switching == "events":
         if model is not None and model != body:
             raise ValueError("switching='events' runs the plant's own model; give model=None")

@@ -168,3 +168,20 @@ def test_gains_too_stiff_for_a_runs_fixed_steps_are_refused_at_once_naming_the_g
     msg = _refused(lambda: call(Gains(kp=1e6)), r"^gains: ")
     assert re.search(rf"raise (the option )?{option} to \d+", msg), msg
     assert not re.search("non-finite", msg)
+
+
+def test_an_angle_limited_run_locates_its_switching_by_default_and_finishes():
+    # issue 59: simulate(Body(), Gains(), eight(1.5, 0.6), 2 T, limits=Limits(angle=40 deg)) ran for
+    # minutes without a word under the step-size control; by default it now locates the switching
+    from lib.allocation import Limits
+    ref = T.eight(1.5, 0.6)
+    lim = Limits(angle=np.radians(40))
+    t = time.perf_counter()
+    res = simulate(B, G, ref, 2 * ref.period, limits=lim)
+    assert time.perf_counter() - t < 60.0                    # measured about 1 s; minutes before
+    assert res.mode is not None                              # the event-located loop ran
+    ev = simulate(B, G, ref, 2 * ref.period, limits=lim, integration=Integration(switching="events"))
+    np.testing.assert_array_equal(res.z, ev.z)               # exact: the same code path
+    assert Integration().switching == "auto"
+    # where the event-located loop does not apply (no angle limit), the default is the adaptive run
+    assert simulate(B, G, ref, 1.0).mode is None

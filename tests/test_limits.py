@@ -122,7 +122,7 @@ def test_event_located_and_stepsize_runs_agree_at_tight_tolerance(perturb):
     a = simulate(Body(), Gains(), ref, 12.0, s0[:3], s0[3:], limits=Limits(angle=bmax),
                  integration=Integration(rtol=1e-11, atol=1e-11, switching="events"))
     b = simulate(Body(), Gains(), ref, 12.0, s0[:3], s0[3:], limits=Limits(angle=bmax),
-                 integration=Integration(rtol=1e-11, atol=1e-11))
+                 integration=Integration(rtol=1e-11, atol=1e-11, switching="stepsize"))
     assert np.all(a.mode != 0)
     assert np.abs(a.z - b.z).max() < 3e-8  # measured 2.9e-9
 

@@ -20,7 +20,7 @@ from scipy.integrate import solve_ivp
 __all__ = ["Integration", "SimulationError", "integrate", "SWITCHING"]
 
 #: how a discontinuity of the field (an angle limit) is integrated
-SWITCHING = ("stepsize", "events")
+SWITCHING = ("auto", "stepsize", "events")
 
 
 class SimulationError(RuntimeError):
@@ -37,14 +37,18 @@ class Integration:
     absolute tolerances ``rtol`` and ``atol``, ``max_step`` (s), the magnitude
     ``blowup`` of a state that counts as blown up, and ``switching``: ``"stepsize"``
     leaves an angle limit's discontinuity to the step-size control, ``"events"``
-    locates it (:mod:`lib.integrators.switched`). Validated on construction."""
+    locates it (:mod:`lib.integrators.switched`), and ``"auto"`` (the default) locates
+    it wherever the event-located loop applies (an angle limit below pi on the paper's
+    position-only law, the plant its own model: :func:`lib.simulate.simulate`), since
+    the step-size control crawls along a sliding motion. Validated on construction.
+    """
 
     method: str = "DOP853"
     rtol: float = 1e-10
     atol: float = 1e-10
     max_step: float = math.inf
     blowup: float = 1e8
-    switching: str = "stepsize"
+    switching: str = "auto"
 
     def accuracy(self, scale: float) -> float:
         """The error the book takes a run of a smooth, contracting loop to hold: ten times the
