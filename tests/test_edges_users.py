@@ -185,3 +185,13 @@ def test_an_angle_limited_run_locates_its_switching_by_default_and_finishes():
     assert Integration().switching == "auto"
     # where the event-located loop does not apply (no angle limit), the default is the adaptive run
     assert simulate(B, G, ref, 1.0).mode is None
+
+
+def test_a_run_too_long_because_its_path_is_slow_names_the_paths_rate_not_the_gains():
+    # issue 59: simulate(..., circle(theta=1e-9), ...) was refused as "body and gains: ...", although
+    # Theta is what is wrong (lib.machinery.domain.rate_culprit decides, as the sweeps do)
+    ref = T.circle(theta=1e-9)
+    msg = _refused(lambda: simulate(B, G, ref, 2 * ref.period), r"^ref\.theta = 1e-09 rad/s")
+    assert "t_end <= " in msg
+    # stiff gains on an ordinary path are still named as the gains
+    _refused(lambda: simulate(B, Gains(kp=1e6), T.circle(), 10.0), r"^body and gains: ")
