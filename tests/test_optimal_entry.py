@@ -115,13 +115,3 @@ def test_the_basin_with_the_entry_reaches_the_orbit_from_moved_starts(capped30):
     assert fr.entry.all() and fr.reached.all() and fr.settled.all()
     with pytest.raises(TypeError, match="limits"):
         study.entry_basin(BODY, capped30, None)
-
-
-def test_the_entry_margin_table_writes_each_direction_its_levels_and_none_failed():
-    import pandas as pd
-    em = pd.DataFrame(dict(quantity=["heading", "m"], sign=[1, -1], reached=[0.4, 0.0875], failed=[0.5, np.nan],
-                           tried=[7, 5]))
-    t = study.entry_margin_table(em)
-    assert list(t["disturbance"]) == ["heading + (rad)", "m - (%)"]
-    # exact levels, the mass in per cent
-    assert list(t["reaches at"]) == ["0.4", "8.75"] and list(t["fails at"]) == ["0.5", "none failed"]

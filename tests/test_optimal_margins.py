@@ -14,6 +14,7 @@ import math
 from dataclasses import replace
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from lib.allocation import Limits
@@ -239,3 +240,12 @@ def test_the_entry_margin_brackets_a_reach_boundary(motion, lqr):
                 plant, start = BODY, paper + r.sign * level * np.eye(6)[2]
             end = _entry_end_by_solve_ivp(plant, motion, plan, start)
             assert _reaches_alone(plant, motion, lqr, end) == want, (r, level)
+
+
+def test_the_entry_margin_table_writes_each_direction_its_levels_and_none_failed():
+    em = pd.DataFrame(dict(quantity=["heading", "m"], sign=[1, -1], reached=[0.4, 0.0875], failed=[0.5, np.nan],
+                           tried=[7, 5]))
+    t = mg.entry_margin_table(em)
+    assert list(t["disturbance"]) == ["heading + (rad)", "m - (%)"]
+    # exact levels, the mass in per cent
+    assert list(t["reaches at"]) == ["0.4", "8.75"] and list(t["fails at"]) == ["0.5", "none failed"]

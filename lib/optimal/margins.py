@@ -14,10 +14,9 @@
 * A *push*: a constant world-frame force (Fx, Fy) (N) on the body, which no parameter of the
   model represents; its loop is integrated in numpy (:func:`lib.optimal.verdict.pushed_verdict`,
   the same two RK4 maps and the same decision as :func:`lib.optimal.verdict.motion_verdict`).
-* The *entry* planned on the model (:func:`lib.optimal.collocation.entry_motion`), run open loop
-  on a wrong or pushed plant or from a disturbed start (:func:`entry_end`), then the tracker:
-  whether the paper's start reaches the orbit (:func:`wrong_model_cases`), and how large a
-  disturbance it survives (:func:`entry_margin`).
+* The *entry* planned on the model (:func:`lib.optimal.collocation.entry_motion`), run open loop on a
+  wrong or pushed plant or from a disturbed start (:func:`entry_end`), then the tracker: whether the
+  paper's start reaches the orbit (:func:`wrong_model_cases`), and the margin (:func:`entry_margin`).
 * A *second eight*: the bound, the paper's law under the cap and the best motion found with its
   tracker at another point of Fig. 5's grid (:func:`eight_comparison`).
 
@@ -37,7 +36,7 @@ from ..allocation import Limits
 from ..integrators.batch import RK4, integrate
 from ..machinery import checks
 from ..machinery.cache import cached
-from ..machinery.kinds import lower_bound, upper_bound
+from ..machinery.kinds import upper_bound
 from ..model import config_accel
 from ..params import Body, Gains
 from ..tracking.mismatch import PARAMETERS, model_of
@@ -51,9 +50,10 @@ from .study import PAPER_CAP, setting_label
 from .tracker import DEFAULT_STARTS, RTOL, PeriodicLQR, _edges, _limits, _loop_inputs, _piecewise_ivp, periodic_lqr, track_motion
 from .verdict import _pushed_loop, motion_verdict, pushed_verdict
 
-__all__ = ["MARGIN", "MARGIN_SETTINGS", "WRONG_DELTA", "PUSH", "SECOND_EIGHT", "ENTRY_STEPS", "ENTRY_FIRST", "ENTRY_DOUBLINGS",
-           "ENTRY_HALVINGS", "plant_lqr", "tracked_case", "entry_end", "entry_margin", "margin_cases",
-           "wrong_model_cases", "eight_comparison", "issue_study", "margin_table", "wrong_model_table", "eights_table"]
+__all__ = ["MARGIN", "MARGIN_SETTINGS", "WRONG_DELTA", "PUSH", "SECOND_EIGHT", "ENTRY_STEPS", "ENTRY_FIRST",
+           "ENTRY_DOUBLINGS", "ENTRY_HALVINGS", "plant_lqr", "tracked_case", "entry_end", "entry_margin",
+           "margin_cases", "wrong_model_cases", "eight_comparison", "issue_study", "margin_table",
+           "wrong_model_table", "entry_margin_table"]
 
 #: the margin, the plan's cap as a fraction of the cap in the loop
 MARGIN = 0.9
@@ -179,10 +179,15 @@ def tracked_case(model: Body, motion, limits: Limits, *, plant: Body | None = No
 def entry_end(plant: Body, motion, entry: Entry, start=None, *, push=None) -> np.ndarray:
     """Where the inputs of ``entry`` (planned on the model, :func:`lib.optimal.collocation.entry_motion`),
     applied open loop, bring ``plant`` from ``start`` ((6,) or (S, 6), default the paper's start)
-    under an optional constant world-frame ``push`` (Fx, Fy) (N): the states at t = ``entry.periods``
-    T, the motion's phase 0, the heading brought back by the plan's turns as in
-    :attr:`lib.optimal.collocation.Entry.end`, shaped as ``start``. RK4, :data:`ENTRY_STEPS` steps
-    an input piece."""
+    under an optional constant world-frame ``push`` (Fx, Fy) (N). RK4, :data:`ENTRY_STEPS` steps
+    an input piece.
+
+    Returns
+    -------
+    numpy.ndarray
+        The states at t = ``entry.periods`` T, the motion's phase 0, shaped as ``start``, the
+        heading brought back by the plan's turns as in :attr:`lib.optimal.collocation.Entry.end`.
+    """
     checks.instance("plant", plant, Body)
     checks.instance("entry", entry, Entry, "lib.optimal.collocation.Entry")
     x0 = checks.array("start", DEFAULT_STARTS[0] if start is None else start)
@@ -214,19 +219,17 @@ def entry_margin(body: Body, motion, limits: Limits, *, first=ENTRY_FIRST, doubl
     Returns
     -------
     pandas.DataFrame
-        One row a direction: quantity, sign (+1, -1), reached (the largest level reached, every
-        level tried below it reached too), failed (the next level tried, which does not reach;
-        NaN if none failed), tried (levels decided).
+        One row a direction: quantity, sign (+1, -1), reached (the largest level reached, every level
+        tried below it reached too), failed (the next level tried, not reached; NaN if none), tried.
     """
     checks.instance("body", body, Body)
     checks.instance("limits", limits, Limits, "lib.allocation.Limits")
-    for q in first:
-        checks.one_of("first", q, ("heading", "x", "y", "m"))
-    dirs = [(q, sgn, checks.number(f"first[{q!r}]", v, positive=True)) for q, v in first.items() for sgn in (1, -1)]
+    dirs = [(checks.one_of("first", q, ("heading", "x", "y", "m")), sgn, checks.number(f"first[{q!r}]", v, positive=True))
+            for q, v in first.items() for sgn in (1, -1)]
     doublings, halvings = checks.integer("doublings", doublings, minimum=0), checks.integer("halvings", halvings, minimum=0)
     lqr, plan = periodic_lqr(body, motion), entry_motion(body, motion)
+    level = np.array([d[2] for d in dirs])
     lo, hi, tried = np.zeros(len(dirs)), np.full(len(dirs), np.nan), np.zeros(len(dirs), int)
-    level = np.array([v for *_, v in dirs])
     for k in range(doublings + 1 + halvings):
         todo = np.flatnonzero(np.isnan(hi) if k <= doublings else np.isfinite(hi))
         if k > doublings:
@@ -235,8 +238,7 @@ def entry_margin(body: Body, motion, limits: Limits, *, first=ENTRY_FIRST, doubl
         tried[todo] += 1
         lo[todo[ok]], hi[todo[~ok]] = level[todo[ok]], level[todo[~ok]]
         level[todo[ok]] *= 2 if k < doublings else 1
-    return pd.DataFrame(dict(quantity=[d[0] for d in dirs], sign=[d[1] for d in dirs], reached=lo, failed=hi,
-                             tried=tried))
+    return pd.DataFrame(dict(quantity=[d[0] for d in dirs], sign=[d[1] for d in dirs], reached=lo, failed=hi, tried=tried))
 
 
 def _entry_reaches(body: Body, motion, limits: Limits, lqr: PeriodicLQR, plan: Entry, cases) -> np.ndarray:
@@ -313,10 +315,8 @@ def wrong_model_cases(body: Body, plans: dict, *, delta: float = WRONG_DELTA, pu
 
     Parameters
     ----------
-    body : Body
-        The model (the plans' body).
-    plans : dict
-        (setting, margin) -> (PeriodicMotion, PeriodicLQR) (:func:`margin_cases`).
+    body, plans : Body, dict
+        The model (the plans' body); (setting, margin) -> (PeriodicMotion, PeriodicLQR) (:func:`margin_cases`).
     delta, parameters : float, sequence of str
         The plant's relative error, in (0, 1), in each of ``parameters`` (of
         :data:`lib.tracking.mismatch.PARAMETERS`).
@@ -465,7 +465,13 @@ def wrong_model_table(frame: pd.DataFrame, setting: str, margin: bool) -> pd.Dat
     :func:`lib.optimal.study.setting_label`) and ``margin`` (bool) as the page shows them, one row
     a case: the plant's parameter, its change, the tracker's cells and, where the frame has them,
     whether the paper's start reaches the orbit after the entry ("yes", "no", or "undecided"
-    where the verdict's two maps disagree)."""
+    where the verdict's two maps disagree).
+
+    Returns
+    -------
+    pandas.DataFrame
+        The cells, formatted.
+    """
     rows = frame[(frame.setting == setting) & (frame.margin == margin)]
     if rows.empty:
         raise ValueError(f"setting = {setting!r} with margin = {margin} has no rows")
@@ -477,24 +483,18 @@ def wrong_model_table(frame: pd.DataFrame, setting: str, margin: bool) -> pd.Dat
                          **_tracked_cells(rows), **entry})
 
 
-def eights_table(rows: list) -> pd.DataFrame:
-    """The headline comparison on each eight: the certified bound on the largest distance
-    (rounded down), the paper's law's and the tracker of the best motion found's (rounded up),
-    and the paper's law over the bound (rounded up: the bound is a lower bound).
-
-    Parameters
-    ----------
-    rows : list of dict
-        Each with name, R (m), Theta (rad/s), bound, paper, best (largest distances, m).
+def entry_margin_table(margin: pd.DataFrame) -> pd.DataFrame:
+    """:func:`entry_margin`'s frame as the page shows it.
 
     Returns
     -------
     pandas.DataFrame
-        One row an eight.
+        One row a direction: the disturbance, the largest level at which the entry and the LQR
+        reach the orbit, and the next level tried, which fails ("none failed" when every level
+        tried reaches); exact levels, the mass in per cent.
     """
-    return pd.DataFrame({"eight": [r["name"] for r in rows],
-                         "$R$ (m), $\\Theta$ (rad/s)": [f"{r['R']:g}, {r['Theta']:.3g}" for r in rows],
-                         "bound (m)": [lower_bound(r["bound"], ".4f").text() for r in rows],
-                         "paper's law (m)": [upper_bound(r["paper"], ".3f").text() for r in rows],
-                         "best found + LQR (m)": [upper_bound(r["best"], ".4f").text() for r in rows],
-                         "paper / bound": [upper_bound(r["paper"] / r["bound"], ".2f").text() for r in rows]})
+    unit = {"heading": ("heading", "rad", 1), "x": ("x", "m", 1), "y": ("y", "m", 1), "m": ("m", "%", 100)}
+    name = [f"{unit[q][0]} {'+' if s > 0 else '-'} ({unit[q][1]})" for q, s in zip(margin.quantity, margin.sign)]
+    at = lambda col: [f"{v * unit[q][2]:.4g}" if np.isfinite(v) else "none failed"   # noqa: E731
+                      for q, v in zip(margin.quantity, margin[col])]
+    return pd.DataFrame({"disturbance": name, "reaches at": at("reached"), "fails at": at("failed")})

@@ -446,18 +446,6 @@ def entry_table(rows: pd.DataFrame) -> pd.DataFrame:
         "end gap (m)": [up(v, ".0e") for v in rows.end_position]})
 
 
-def entry_margin_table(margin: pd.DataFrame) -> pd.DataFrame:
-    """:func:`lib.optimal.margins.entry_margin` as the page shows it, one row a direction: the
-    disturbance, the largest level at which the entry and the LQR reach the orbit, and the next
-    level tried, which fails ("none failed" when every level tried reaches); exact levels (the
-    mass in per cent)."""
-    unit = {"heading": ("heading", "rad", 1), "x": ("x", "m", 1), "y": ("y", "m", 1), "m": ("m", "%", 100)}
-    name = [f"{unit[q][0]} {'+' if s > 0 else '-'} ({unit[q][1]})" for q, s in zip(margin.quantity, margin.sign)]
-    at = lambda col: [f"{v * unit[q][2]:.4g}" if np.isfinite(v) else "none failed"   # noqa: E731
-                      for q, v in zip(margin.quantity, margin[col])]
-    return pd.DataFrame({"disturbance": name, "reaches at": at("reached"), "fails at": at("failed")})
-
-
 def entry_basin(body: Body, motion: PeriodicMotion, limits: Limits, *,
                 heading_offsets=np.linspace(-np.pi, np.pi, 5)[:-1], position_offsets=(-1.0, 0.0, 1.0),
                 periods: int = 2, steps: int = 2, verdict_periods: int = 8) -> pd.DataFrame:
