@@ -257,7 +257,7 @@ def cap_alone():
     return chain
 
 
-def test_under_the_cap_alone_every_start_the_convex_one_included_ends_in_one_optimum(cap_alone):
+def test_under_the_cap_alone_every_start_the_convex_one_included_ties_no_other_optimum_is_met(cap_alone):
     m80 = cap_alone[0]
     assert [s[0] for s in m80.starts] == ["paper", "force", "shifted+", "shifted-", "convex"]
     rms = np.array([s[1] for s in m80.starts])

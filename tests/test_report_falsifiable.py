@@ -400,7 +400,8 @@ def _issue51(*, regimes=None, mu_on=None, cost=None, wrong_regime=None, worst=0.
                                 rms_error=0.1 + ((cost or {}).get(s, 0.07) if m else 0.0),
                                 starts_reached=3, starts=7, plan_cap=3.6 if m else 4.0)
                            for s in _MARGIN_SETTINGS for m in (False, True)])
-    wrong = pd.DataFrame([dict(setting=s, margin=m, parameter=p, regime="periodic", rms_error=0.2)
+    wrong = pd.DataFrame([dict(setting=s, margin=m, parameter=p, regime="periodic", rms_error=0.2,
+                               paper_start_reached=True, entry_reached=False)
                           for s in _MARGIN_SETTINGS for m in (False, True) for p in ("m", "c")])
     wrong.loc[0, "rms_error"] = worst
     for i, r in (wrong_regime or {}).items():

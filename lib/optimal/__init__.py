@@ -9,13 +9,15 @@
   verified by integrating its inputs (:func:`periodic_motion`, :func:`verify_motion`);
 * :mod:`.tracker`: a controller that reaches such a motion, the periodic LQR of its
   linearisation with the limits enforced in the loop (:func:`track_motion`), decided by the
-  book's procedure in :mod:`.verdict` (:func:`motion_verdict`, and its basin);
+  book's procedure in :mod:`.verdict` (:func:`motion_verdict`, its basin, and the verdict of
+  the loop under a push);
 * :mod:`.demand`: the force that exact tracking of C and of P needs over Fig. 5's grid;
 * :mod:`.loop`: any of the book's closed loops decided by the book's orbit procedure and measured;
 * :mod:`.study` and :mod:`.compare`: the chapter's computations, each one call shared with the
   report, and every law of the book under each limit setting beside the best motion and the bound;
 * :mod:`.margins`: the tracker planned with a margin under the limits, run on a wrong plant and
-  under a push, and the headline comparison on a second eight.
+  under a push, the entry run open loop there and from disturbed starts (its measured margin),
+  and the headline comparison on a second eight.
 """
 
 from .bound import CapBound, cap_bound, exact_peak_force

@@ -40,7 +40,7 @@ from .verdict import basin, motion_verdict
 
 __all__ = ["LAWS", "LawLoop", "law_loop", "law_row", "paper_rows", "side_by_side", "WEIGHTS", "THRUST0",
            "LAW_OPTIONS", "LAW_STEPS", "LAW_MAX_STEPS", "PAPER_HORIZON", "PAPER_MEASURED", "RMS_BLOCK",
-           "limits_study", "LAW_NAMES", "error_table", "regime_table", "tracker_table"]
+           "limits_study", "LAW_NAMES", "error_table", "regime_table", "tracker_table", "eights_table"]
 
 #: periods the paper's law runs from the paper's start where it reaches no orbit (:func:`paper_rows`)
 PAPER_HORIZON = 120
@@ -437,3 +437,26 @@ def tracker_table(table: pd.DataFrame) -> pd.DataFrame:
                                                                            pd.Series(True, index=opt.index)))],
         "largest (m)": [upper_bound(v, ".3g").text() for v in opt.max_error],
         "RMS (m)": [upper_bound(v, ".3g").text() for v in opt.rms_error]})
+
+
+def eights_table(rows: list) -> pd.DataFrame:
+    """The headline comparison on each eight: the certified bound on the largest distance
+    (rounded down), the paper's law's and the tracker of the best motion found's (rounded up),
+    and the paper's law over the bound (rounded up: the bound is a lower bound).
+
+    Parameters
+    ----------
+    rows : list of dict
+        Each with name, R (m), Theta (rad/s), bound, paper, best (largest distances, m).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row an eight.
+    """
+    return pd.DataFrame({"eight": [r["name"] for r in rows],
+                         "$R$ (m), $\\Theta$ (rad/s)": [f"{r['R']:g}, {r['Theta']:.3g}" for r in rows],
+                         "bound (m)": [lower_bound(r["bound"], ".4f").text() for r in rows],
+                         "paper's law (m)": [upper_bound(r["paper"], ".3f").text() for r in rows],
+                         "best found + LQR (m)": [upper_bound(r["best"], ".4f").text() for r in rows],
+                         "paper / bound": [upper_bound(r["paper"] / r["bound"], ".2f").text() for r in rows]})

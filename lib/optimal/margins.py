@@ -12,8 +12,11 @@
   :func:`lib.optimal.verdict.motion_verdict`, run on the plant (their compiled kernels included),
   apply the nominal gain exactly (to rounding) while the plant moves by its own parameters.
 * A *push*: a constant world-frame force (Fx, Fy) (N) on the body, which no parameter of the
-  model represents; its loop is integrated in numpy (:func:`pushed_verdict`, the same two RK4
-  maps and the same decision as :func:`lib.optimal.verdict.motion_verdict`).
+  model represents; its loop is integrated in numpy (:func:`lib.optimal.verdict.pushed_verdict`,
+  the same two RK4 maps and the same decision as :func:`lib.optimal.verdict.motion_verdict`).
+* The *entry* planned on the model (:func:`lib.optimal.collocation.entry_motion`), run open loop on a
+  wrong or pushed plant or from a disturbed start (:func:`entry_end`), then the tracker: whether the
+  paper's start reaches the orbit (:func:`wrong_model_cases`), and the margin (:func:`entry_margin`).
 * A *second eight*: the bound, the paper's law under the cap and the best motion found with its
   tracker at another point of Fig. 5's grid (:func:`eight_comparison`).
 
@@ -30,27 +33,27 @@ import numpy as np
 import pandas as pd
 
 from ..allocation import Limits
-from ..integrators.batch import RK4, fixed_steps, integrate
-from ..integrators.smooth import SimulationError
+from ..integrators.batch import RK4, integrate
 from ..machinery import checks
 from ..machinery.cache import cached
-from ..machinery.kinds import lower_bound, upper_bound
+from ..machinery.kinds import upper_bound
 from ..model import config_accel
 from ..params import Body, Gains
 from ..tracking.mismatch import PARAMETERS, model_of
 from ..trajectories import make
 from .bound import cap_bound, exact_peak_force
+from .collocation import Entry, entry_motion
 from .compare import OPTIMAL_PERIODS, OPTIMAL_STEPS, limits_study, paper_rows
 from .loop import steady_measures
 from .motion import periodic_motion
 from .study import PAPER_CAP, setting_label
-from .tracker import (DEFAULT_STARTS, RTOL, PeriodicLQR, _edges, _inside, _inside_bounds, _limits, _loop_inputs, _loop_reference,
-                      _piecewise_ivp, _reference, periodic_lqr, track_motion)
-from .verdict import NEWTON_TOL, ORBIT_SHIFT_TOL, MotionVerdict, _decide, _ladder, _orbit, motion_verdict
+from .tracker import DEFAULT_STARTS, RTOL, PeriodicLQR, _edges, _limits, _loop_inputs, _piecewise_ivp, periodic_lqr, track_motion
+from .verdict import _pushed_loop, motion_verdict, pushed_verdict
 
-__all__ = ["MARGIN", "MARGIN_SETTINGS", "WRONG_DELTA", "PUSH", "SECOND_EIGHT", "plant_lqr", "pushed_verdict",
-           "tracked_case", "margin_cases", "wrong_model_cases", "eight_comparison", "issue_study",
-           "margin_table", "wrong_model_table", "eights_table"]
+__all__ = ["MARGIN", "MARGIN_SETTINGS", "WRONG_DELTA", "PUSH", "SECOND_EIGHT", "ENTRY_STEPS", "ENTRY_FIRST",
+           "ENTRY_DOUBLINGS", "ENTRY_HALVINGS", "plant_lqr", "tracked_case", "entry_end", "entry_margin",
+           "margin_cases", "wrong_model_cases", "eight_comparison", "issue_study", "margin_table",
+           "wrong_model_table", "entry_margin_table"]
 
 #: the margin, the plan's cap as a fraction of the cap in the loop
 MARGIN = 0.9
@@ -60,6 +63,12 @@ MARGIN_SETTINGS = ((None, PAPER_CAP), (30, PAPER_CAP))
 WRONG_DELTA = 0.1
 #: the disturbance, a constant world-frame push (N) along x
 PUSH = (0.2, 0.0)
+#: RK4 steps on each input piece of an entry run open loop (:func:`entry_end`): its end moves by
+#: about 1e-6 against DOP853 at rtol 1e-10 (14 times less a halving), a thousandth of the reach tolerance
+ENTRY_STEPS = 4
+#: the entry's disturbances (:func:`entry_margin`), each with its first level (heading in rad, x and y
+#: in m, m relative), and the search's doublings and halvings
+ENTRY_FIRST, ENTRY_DOUBLINGS, ENTRY_HALVINGS = {"heading": 0.05, "x": 0.05, "y": 0.05, "m": 0.025}, 4, 2
 #: the second eight (R in m, Theta in rad/s), a point of Fig. 5's grid where the 4 N cap binds
 SECOND_EIGHT = (1.5, 1.2)
 
@@ -94,94 +103,6 @@ def plant_lqr(lqr: PeriodicLQR, plant: Body) -> PeriodicLQR:
     return replace(lqr, body=plant, P=lqr.P / s[:, None], dP=lqr.dP / s[:, None])
 
 
-def _pushed_loop(lqr: PeriodicLQR, F_max: float, beta_max, rows: int, push, memo: dict):
-    """The clipped loop's rates on an input piece, as :func:`lib.optimal.tracker.track_motion`'s,
-    plus the constant world-frame force ``push`` (N) on the body ``lqr.body``; ``memo`` keeps
-    (x*, u*, K) by (t, lo, hi), which fixed steps meet every period."""
-    body, (px, py) = lqr.body, push
-
-    def piece(lo, hi):
-        def rhs(t, s):
-            X = s.reshape(rows, 6)
-            ref = memo.get((t, lo, hi))
-            if ref is None:
-                ref = memo[t, lo, hi] = _loop_reference(lqr, t, _inside(t, lo, hi))
-            F, beta = _loop_inputs(lqr, t, X, F_max, beta_max, ref=ref)
-            acc = config_accel(body, X[:, :3], X[:, 3:], F, beta)
-            acc[:, 0] += px / body.m
-            acc[:, 1] += py / body.m
-            out = np.concatenate([X[:, 3:], acc], -1).ravel()
-            if not np.all(np.isfinite(out)):
-                raise SimulationError(f"pushed loop became non-finite at t = {t:.6g} s")
-            return out
-        return rhs
-    return piece
-
-
-def _pushed_map(lqr: PeriodicLQR, F_max, beta_max, steps: int, push):
-    """The pushed loop's period map (as :func:`lib.optimal.verdict._period_map` with ``steps``
-    RK4 steps an input piece): x (M, 6) at t = 0 -> one period later, less the heading's turns."""
-    motion = lqr.motion
-    shift, edges, memo = 2 * np.pi * motion.turns * np.eye(6)[2], _edges(motion, 0.0, motion.period), {}
-
-    def advance(X):
-        y = X.ravel()
-        try:
-            for a, b in zip(edges[:-1], edges[1:]):
-                y = integrate(_pushed_loop(lqr, F_max, beta_max, X.shape[0], push, memo)(a, b), y, a, b,
-                              (b - a) / steps, RK4)[1][-1]
-        except FloatingPointError as err:
-            raise SimulationError(f"the pushed period map blew up: {err}") from None
-        return y.reshape(X.shape) - shift
-    return advance
-
-
-def pushed_verdict(body: Body, motion, push, *, limits: Limits | None = None, lqr: PeriodicLQR | None = None,
-                   starts=None, periods: int = OPTIMAL_PERIODS, steps: int = OPTIMAL_STEPS,
-                   h: float = 1e-5) -> MotionVerdict:
-    """:func:`lib.optimal.verdict.motion_verdict` of the loop with a constant world-frame force
-    ``push`` = (Fx, Fy) (N) on ``body``: Newton on two RK4 maps (``steps`` and twice as many steps
-    an input piece, doubled while the orbit moves by more than
-    :data:`lib.optimal.verdict.ORBIT_SHIFT_TOL`), the multipliers, and the starts' reach test, by
-    the same decision. Integrated in numpy (no compiled kernel takes a push): about a second of
-    CPU a verdict at the chapter's steps.
-
-    Parameters
-    ----------
-    body, motion, limits, lqr
-        As in :func:`lib.optimal.verdict.motion_verdict` (``lqr`` may be a :func:`plant_lqr`).
-    push : array_like
-        (Fx, Fy) (N), world frame.
-    starts, periods, steps, h
-        As in :func:`lib.optimal.verdict.motion_verdict`.
-
-    Returns
-    -------
-    MotionVerdict
-    """
-    checks.instance("body", body, Body)
-    push = tuple(float(p) for p in checks.array("push", push, shape=(2,)))
-    steps = checks.integer("steps", steps, minimum=1)
-    periods = checks.integer("periods", periods, minimum=2)
-    lqr = lqr or periodic_lqr(body, motion)
-    if lqr.body != body or lqr.motion is not motion:
-        raise ValueError("lqr must be a periodic LQR of this body and motion")
-    starts = checks.array("starts", DEFAULT_STARTS if starts is None else starts, shape=(None, 6), nonempty=True)
-    F_max, beta_max = _limits(limits, motion)
-    x_star = _reference(motion, 0.0)[0]
-    ladder = _ladder(steps, len(_edges(motion, 0.0, motion.period)) - 1)
-    coarse = _pushed_map(lqr, F_max, beta_max, ladder[0][0], push)
-    orb_c = _orbit(coarse, x_star, h)
-    for j in range(1, len(ladder)):
-        fine = _pushed_map(lqr, F_max, beta_max, ladder[j][0], push)
-        orb_f = _orbit(fine, orb_c.x[0] if orb_c.residual[0] <= NEWTON_TOL else x_star, h)
-        shift = float(np.abs(orb_f.x[0] - orb_c.x[0]).max())
-        if not (shift > ORBIT_SHIFT_TOL) or j == len(ladder) - 1:
-            break
-        coarse, orb_c = fine, orb_f
-    return _decide(orb_c, orb_f, coarse, fine, x_star, starts, periods, h, ladder[j - 1][0], shift)
-
-
 def _orbit_measures(plant: Body, motion, limits: Limits, lqr: PeriodicLQR, x, push) -> dict:
     """The errors and inputs over one period of the loop from its orbit point x (6,) at t = 0,
     1024 equal samples (DOP853 at :data:`lib.optimal.tracker.RTOL`), by
@@ -203,34 +124,34 @@ def _orbit_measures(plant: Body, motion, limits: Limits, lqr: PeriodicLQR, x, pu
 
 
 def tracked_case(model: Body, motion, limits: Limits, *, plant: Body | None = None, push=None,
-                 lqr: PeriodicLQR | None = None) -> dict:
+                 lqr: PeriodicLQR | None = None, entry_start=None) -> dict:
     """The tracker of ``motion``, planned and gained on ``model``, run on ``plant`` (default the
     model) with an optional constant world-frame ``push`` (N), decided by the book's procedure
-    (:func:`lib.optimal.verdict.motion_verdict` on :func:`plant_lqr`, or :func:`pushed_verdict`)
-    at the chapter's steps and periods (:data:`lib.optimal.compare.OPTIMAL_STEPS`,
-    :data:`lib.optimal.compare.OPTIMAL_PERIODS`) and measured over one period of its orbit.
+    (:func:`lib.optimal.verdict.motion_verdict` on :func:`plant_lqr`, or
+    :func:`lib.optimal.verdict.pushed_verdict`) at the chapter's steps and periods
+    (:data:`lib.optimal.compare.OPTIMAL_STEPS`, :data:`lib.optimal.compare.OPTIMAL_PERIODS`) and
+    measured over one period of its orbit.
 
     Parameters
     ----------
-    model : Body
-        The body the motion and the gain were computed for.
-    motion : PeriodicMotion
-        The motion (of ``model``).
-    limits : Limits
-        The limits enforced in the loop.
+    model, motion, limits : Body, PeriodicMotion, Limits
+        The body the motion (of ``model``) and the gain were computed for; the loop's limits.
     plant : Body, optional
         The body that moves.
     push : array_like, optional
         (Fx, Fy) (N), world frame.
     lqr : PeriodicLQR, optional
         The model's periodic LQR of ``motion`` (computed if not given).
+    entry_start : array_like, shape (6,), optional
+        An eighth start, decided beside the seven (where an entry brought the plant, :func:`entry_end`).
 
     Returns
     -------
     dict
         regime, reason, floquet (|mu_1|), starts_reached, starts, paper_start_reached (on both
-        maps), settled (starts with one fate on both maps), and max_error, rms_error (m),
-        F_peak (N), beta_peak (rad), p_range (rad) over one period of the orbit (NaN without one).
+        maps), settled (of the seven starts, those with one fate on both maps), and max_error,
+        rms_error (m), F_peak (N), beta_peak (rad), p_range (rad) over one period of the orbit
+        (NaN without one); with ``entry_start``, entry_reached and entry_settled, its fate.
     """
     checks.instance("model", model, Body)
     checks.instance("limits", limits, Limits, "lib.allocation.Limits")
@@ -239,20 +160,107 @@ def tracked_case(model: Body, motion, limits: Limits, *, plant: Body | None = No
     if lqr.body != model or lqr.motion is not motion:
         raise ValueError("lqr must be the periodic_lqr of model and motion")
     plq = lqr if plant == model else plant_lqr(lqr, plant)
+    n, starts = len(DEFAULT_STARTS), DEFAULT_STARTS
+    if entry_start is not None:
+        starts = np.vstack([starts, checks.array("entry_start", entry_start, shape=(6,))])
+    run = dict(limits=limits, lqr=plq, starts=starts, steps=OPTIMAL_STEPS, periods=OPTIMAL_PERIODS)
     if push is None:
-        v = motion_verdict(plant, motion, limits=limits, lqr=plq, steps=OPTIMAL_STEPS, periods=OPTIMAL_PERIODS)
+        v = motion_verdict(plant, motion, **run)
     else:
         push = tuple(float(p) for p in checks.array("push", push, shape=(2,)))
-        v = pushed_verdict(plant, motion, push, limits=limits, lqr=plq)
+        v = pushed_verdict(plant, motion, push, **run)
     meas = _orbit_measures(plant, motion, limits, plq, v.x, push)
+    extra = {} if entry_start is None else dict(entry_reached=bool(v.reached[n]), entry_settled=bool(v.settled[n]))
     return dict(regime=v.regime, reason=v.reason, floquet=float(np.abs(v.multipliers).max()),
-                starts_reached=int(v.reached.sum()), starts=int(v.reached.size),
-                paper_start_reached=bool(v.reached[0]), settled=int(v.settled.sum()), **meas)
+                starts_reached=int(v.reached[:n].sum()), starts=n, paper_start_reached=bool(v.reached[0]),
+                settled=int(v.settled[:n].sum()), **extra, **meas)
+
+
+def entry_end(plant: Body, motion, entry: Entry, start=None, *, push=None) -> np.ndarray:
+    """Where the inputs of ``entry`` (planned on the model, :func:`lib.optimal.collocation.entry_motion`),
+    applied open loop, bring ``plant`` from ``start`` ((6,) or (S, 6), default the paper's start)
+    under an optional constant world-frame ``push`` (Fx, Fy) (N). RK4, :data:`ENTRY_STEPS` steps
+    an input piece.
+
+    Returns
+    -------
+    numpy.ndarray
+        The states at t = ``entry.periods`` T, the motion's phase 0, shaped as ``start``, the
+        heading brought back by the plan's turns as in :attr:`lib.optimal.collocation.Entry.end`.
+    """
+    checks.instance("plant", plant, Body)
+    checks.instance("entry", entry, Entry, "lib.optimal.collocation.Entry")
+    x0 = checks.array("start", DEFAULT_STARTS[0] if start is None else start)
+    X = checks.array("start", np.atleast_2d(x0), shape=(None, 6))
+    px, py = (0.0, 0.0) if push is None else checks.array("push", push, shape=(2,))
+    h, pushed = motion.period / entry.nodes, np.array([px / plant.m, py / plant.m, 0.0])
+    turns = 2 * np.pi * (np.round((X[:, 2] - motion.state(0.0)[0][2]) / (2 * np.pi)) + motion.turns * entry.periods)
+
+    def rates(F, beta):
+        return lambda t, Y: np.concatenate([Y[:, 3:], config_accel(plant, Y[:, :3], Y[:, 3:], F, beta) + pushed], -1)
+    for k, (F, beta) in enumerate(zip(entry.F, entry.beta)):
+        X = integrate(rates(F, beta), X, k * h, (k + 1) * h, h / ENTRY_STEPS, RK4)[1][-1]
+    X[:, 2] -= turns
+    return X.reshape(x0.shape)
+
+
+def entry_margin(body: Body, motion, limits: Limits, *, first=ENTRY_FIRST, doublings: int = ENTRY_DOUBLINGS,
+                 halvings: int = ENTRY_HALVINGS) -> pd.DataFrame:
+    """How far the paper's start may be disturbed while the entry planned from it on ``body``
+    (:func:`lib.optimal.collocation.entry_motion`), run open loop (:func:`entry_end`), and then the
+    periodic LQR still reach the orbit, as :func:`lib.optimal.verdict.motion_verdict` decides
+    (both maps, the chapter's steps and periods). Each quantity of ``first`` (quantity -> first
+    level: "heading" (rad), "x", "y" (m), the start moved; "m" (relative), the plant
+    :func:`lib.tracking.mismatch.model_of`) is moved either way: the level doubles from the first
+    while the orbit is reached (at most ``doublings`` times), then the bracket between the last
+    level reached (0 if none) and the first that failed (an undecided verdict fails) is halved
+    ``halvings`` times. A measured margin, not a bound: levels between those tried are not tried.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row a direction: quantity, sign (+1, -1), reached (the largest level reached, every level
+        tried below it reached too), failed (the next level tried, not reached; NaN if none), tried.
+    """
+    checks.instance("body", body, Body)
+    checks.instance("limits", limits, Limits, "lib.allocation.Limits")
+    dirs = [(checks.one_of("first", q, ("heading", "x", "y", "m")), sgn, checks.number(f"first[{q!r}]", v, positive=True))
+            for q, v in first.items() for sgn in (1, -1)]
+    doublings, halvings = checks.integer("doublings", doublings, minimum=0), checks.integer("halvings", halvings, minimum=0)
+    lqr, plan = periodic_lqr(body, motion), entry_motion(body, motion)
+    level = np.array([d[2] for d in dirs])
+    lo, hi, tried = np.zeros(len(dirs)), np.full(len(dirs), np.nan), np.zeros(len(dirs), int)
+    for k in range(doublings + 1 + halvings):
+        todo = np.flatnonzero(np.isnan(hi) if k <= doublings else np.isfinite(hi))
+        if k > doublings:
+            level[todo] = (lo[todo] + hi[todo]) / 2
+        ok = _entry_reaches(body, motion, limits, lqr, plan, [(*dirs[i][:2], level[i]) for i in todo])
+        tried[todo] += 1
+        lo[todo[ok]], hi[todo[~ok]] = level[todo[ok]], level[todo[~ok]]
+        level[todo[ok]] *= 2 if k < doublings else 1
+    return pd.DataFrame(dict(quantity=[d[0] for d in dirs], sign=[d[1] for d in dirs], reached=lo, failed=hi, tried=tried))
+
+
+def _entry_reaches(body: Body, motion, limits: Limits, lqr: PeriodicLQR, plan: Entry, cases) -> np.ndarray:
+    """Whether each case (quantity, sign, level) reaches the orbit after the entry: the moved
+    starts in one verdict, each plant of another mass in its own."""
+    run, out = dict(limits=limits, steps=OPTIMAL_STEPS, periods=OPTIMAL_PERIODS), np.zeros(len(cases), bool)
+    moved = [j for j, c in enumerate(cases) if c[0] != "m"]
+    if moved:
+        starts = np.tile(DEFAULT_STARTS[0], (len(moved), 1))
+        for r, j in enumerate(moved):
+            starts[r, ("x", "y", "heading").index(cases[j][0])] += cases[j][1] * cases[j][2]
+        out[moved] = motion_verdict(body, motion, lqr=lqr, starts=entry_end(body, motion, plan, starts), **run).reached
+    for j, (q, sgn, level) in enumerate(cases):
+        if q == "m":
+            plant = model_of(body, m=sgn * level)
+            out[j] = motion_verdict(plant, motion, lqr=plant_lqr(lqr, plant), starts=entry_end(plant, motion, plan)[None],
+                                    **run).reached[0]
+    return out
 
 
 def _limits_of(setting) -> Limits:
-    angle, cap = setting
-    return Limits(cap, None if angle is None else math.radians(angle))
+    return Limits(setting[1], None if setting[0] is None else math.radians(setting[0]))
 
 
 def margin_cases(body: Body, motions: dict, *, fraction: float = MARGIN) -> dict:
@@ -299,29 +307,31 @@ def margin_cases(body: Body, motions: dict, *, fraction: float = MARGIN) -> dict
 
 
 def wrong_model_cases(body: Body, plans: dict, *, delta: float = WRONG_DELTA, push=PUSH,
-                      push_at=MARGIN_SETTINGS[:1], parameters=PARAMETERS) -> pd.DataFrame:
-    """Each plan's tracker on a plant with one parameter off by +-``delta``, and under ``push``.
+                      push_at=MARGIN_SETTINGS[:1], parameters=PARAMETERS, entry: bool = True) -> pd.DataFrame:
+    """Each plan's tracker on a plant with one parameter off by +-``delta``, and under ``push``;
+    with ``entry``, the paper's start brought by the plan's entry (planned on the model,
+    :func:`lib.optimal.collocation.entry_motion`) run open loop on the plant (:func:`entry_end`),
+    and decided in the same verdict as an eighth start.
 
     Parameters
     ----------
-    body : Body
-        The model (the plans' body).
-    plans : dict
-        (setting, margin) -> (PeriodicMotion, PeriodicLQR) (:func:`margin_cases`).
-    delta : float
-        The plant's relative error, in (0, 1).
-    push : array_like or None
-        (Fx, Fy) (N), world frame, on the nominal plant; None for no push case.
-    push_at : sequence of tuple
-        The settings at which the push is run (a numpy loop: about a second of CPU a case).
-    parameters : sequence of str
-        Of :data:`lib.tracking.mismatch.PARAMETERS`.
+    body, plans : Body, dict
+        The model (the plans' body); (setting, margin) -> (PeriodicMotion, PeriodicLQR) (:func:`margin_cases`).
+    delta, parameters : float, sequence of str
+        The plant's relative error, in (0, 1), in each of ``parameters`` (of
+        :data:`lib.tracking.mismatch.PARAMETERS`).
+    push, push_at : array_like or None, sequence of tuple
+        (Fx, Fy) (N), world frame, on the nominal plant (None for no push case), at the settings
+        ``push_at`` (a numpy loop: about a second of CPU a case).
+    entry : bool
+        Decide the paper's start after the entry too (an IPOPT solve a plan, 0.05 s of CPU a plant).
 
     Returns
     -------
     pandas.DataFrame
         One row a (setting, margin, case): setting, margin, parameter ("push" for the push),
-        delta (relative, 0 for the push), and the columns of :func:`tracked_case`.
+        delta (relative, 0 for the push), and the columns of :func:`tracked_case` (entry_reached
+        and entry_settled with ``entry``).
     """
     checks.instance("body", body, Body)
     delta = checks.number("delta", delta, positive=True, maximum=0.99)
@@ -330,14 +340,17 @@ def wrong_model_cases(body: Body, plans: dict, *, delta: float = WRONG_DELTA, pu
     rows = []
     for ((angle, cap), margin), (motion, lqr) in plans.items():
         base = dict(setting=setting_label(angle, cap), margin=margin)
-        limits = _limits_of((angle, cap))
+        limits, plan = _limits_of((angle, cap)), entry_motion(body, motion) if entry else None
         for p in parameters:
             for d in (delta, -delta):
+                plant = model_of(body, **{p: d})
                 rows.append(dict(base, parameter=p, delta=d, **tracked_case(
-                    body, motion, limits, plant=model_of(body, **{p: d}), lqr=lqr)))
+                    body, motion, limits, plant=plant, lqr=lqr,
+                    entry_start=None if plan is None else entry_end(plant, motion, plan))))
         if push is not None and (angle, cap) in push_at:
+            end = None if plan is None else entry_end(body, motion, plan, push=push)
             rows.append(dict(base, parameter="push", delta=0.0,
-                             **tracked_case(body, motion, limits, push=push, lqr=lqr)))
+                             **tracked_case(body, motion, limits, push=push, lqr=lqr, entry_start=end)))
     return pd.DataFrame(rows)
 
 
@@ -448,50 +461,40 @@ def margin_table(table: pd.DataFrame) -> pd.DataFrame:
 
 
 def wrong_model_table(frame: pd.DataFrame, setting: str, margin: bool) -> pd.DataFrame:
-    """:func:`wrong_model_cases`' rows at one setting and margin as the page shows them:
-    the plant's parameter, its change, and the tracker's cells.
-
-    Parameters
-    ----------
-    frame : pandas.DataFrame
-        :func:`wrong_model_cases`' frame.
-    setting : str
-        The setting's label (:func:`lib.optimal.study.setting_label`).
-    margin : bool
-        With the margin or without.
+    """:func:`wrong_model_cases`' rows (a frame) at one ``setting`` (its label,
+    :func:`lib.optimal.study.setting_label`) and ``margin`` (bool) as the page shows them, one row
+    a case: the plant's parameter, its change, the tracker's cells and, where the frame has them,
+    whether the paper's start reaches the orbit after the entry ("yes", "no", or "undecided"
+    where the verdict's two maps disagree).
 
     Returns
     -------
     pandas.DataFrame
-        One row a case.
+        The cells, formatted.
     """
     rows = frame[(frame.setting == setting) & (frame.margin == margin)]
     if rows.empty:
         raise ValueError(f"setting = {setting!r} with margin = {margin} has no rows")
     change = ["0.2 N along x" if p == "push" else f"{d:+.0%}".replace("%", " %")
               for p, d in zip(rows.parameter, rows.delta)]
+    entry = {} if "entry_reached" not in rows else {"after the entry": [
+        "yes" if r else ("no" if s else "undecided") for r, s in zip(rows.entry_reached, rows.entry_settled)]}
     return pd.DataFrame({"plant's": [_PARAMETER_NAMES[p] for p in rows.parameter], "change": change,
-                         **_tracked_cells(rows)})
+                         **_tracked_cells(rows), **entry})
 
 
-def eights_table(rows: list) -> pd.DataFrame:
-    """The headline comparison on each eight: the certified bound on the largest distance
-    (rounded down), the paper's law's and the tracker of the best motion found's (rounded up),
-    and the paper's law over the bound (rounded up: the bound is a lower bound).
-
-    Parameters
-    ----------
-    rows : list of dict
-        Each with name, R (m), Theta (rad/s), bound, paper, best (largest distances, m).
+def entry_margin_table(margin: pd.DataFrame) -> pd.DataFrame:
+    """:func:`entry_margin`'s frame as the page shows it.
 
     Returns
     -------
     pandas.DataFrame
-        One row an eight.
+        One row a direction: the disturbance, the largest level at which the entry and the LQR
+        reach the orbit, and the next level tried, which fails ("none failed" when every level
+        tried reaches); exact levels, the mass in per cent.
     """
-    return pd.DataFrame({"eight": [r["name"] for r in rows],
-                         "$R$ (m), $\\Theta$ (rad/s)": [f"{r['R']:g}, {r['Theta']:.3g}" for r in rows],
-                         "bound (m)": [lower_bound(r["bound"], ".4f").text() for r in rows],
-                         "paper's law (m)": [upper_bound(r["paper"], ".3f").text() for r in rows],
-                         "best found + LQR (m)": [upper_bound(r["best"], ".4f").text() for r in rows],
-                         "paper / bound": [upper_bound(r["paper"] / r["bound"], ".2f").text() for r in rows]})
+    unit = {"heading": ("heading", "rad", 1), "x": ("x", "m", 1), "y": ("y", "m", 1), "m": ("m", "%", 100)}
+    name = [f"{unit[q][0]} {'+' if s > 0 else '-'} ({unit[q][1]})" for q, s in zip(margin.quantity, margin.sign)]
+    at = lambda col: [f"{v * unit[q][2]:.4g}" if np.isfinite(v) else "none failed"   # noqa: E731
+                      for q, v in zip(margin.quantity, margin[col])]
+    return pd.DataFrame({"disturbance": name, "reaches at": at("reached"), "fails at": at("failed")})

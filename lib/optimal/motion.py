@@ -14,9 +14,10 @@ Defaults and cost: 80 intervals of degree-3 Legendre collocation (2080 unknowns)
 The inputs are held in the body's frame on each interval, so the force turns with the heading
 within it; under the 4 N cap alone the heading turns by up to about 0.6 rad an interval at 80
 intervals, and the best found RMS error falls as h^2 with the mesh towards the convex optimum
-(0.0731, 0.0700, 0.0692 m at 80, 160, 320 intervals; every start, the convex one included, ends
-in the same optimum). Under an angle limit without a cap the optimum asks for force pulses
-that grow as the mesh refines: its RMS error moves by a few per cent between 40 and 160 intervals.
+(0.0731, 0.0700, 0.0692 m at 80, 160, 320 intervals; at 80 every start, the convex one included, ties
+within :data:`START_TIE`: no other optimum is met, not a proof of none). Under an angle limit without a
+cap the optimum asks for force pulses that grow as the mesh refines: its RMS error moves by a few per
+cent between 40 and 160 intervals.
 """
 
 from __future__ import annotations
@@ -41,8 +42,8 @@ __all__ = ["PeriodicMotion", "periodic_motion", "verify_motion", "return_errors"
 #: the starts :func:`periodic_motion` knows ("shifted" is two solves, +- beta_max / 2; "convex"
 #: needs a cap)
 STARTS = ("paper", "force", "shifted", "convex")
-#: starts whose RMS errors (m) differ by less than this end in the same optimum (IPOPT's tol 1e-10 on
-#: the mean square moves the RMS by about 1e-9 m)
+#: starts whose RMS errors (m) differ by less than this are counted as ending at one optimum found
+#: (IPOPT's tol 1e-10 on the mean square moves the RMS by about 1e-9 m)
 START_TIE = 1e-8
 #: the largest mesh accepted (intervals per period)
 MAX_NODES = 2000
@@ -297,7 +298,7 @@ def _convex_held(body: Body, kind: str, R: float, Theta: float, F_max: float, no
 def periodic_motion(body: Body, R: float, Theta: float, *, kind: str = "eight", F_max: float | None = None,
                     beta_max: float | None = None, nodes: int = 80, degree: int = 3, guess=None,
                     starts=None, shifts=()) -> PeriodicMotion:
-    """The periodic motion of the model (2)-(4) that keeps C closest to the path, in RMS.
+    """The best periodic motion found of (2)-(4) for C's RMS distance from the path: a local optimum.
 
     Minimises the mean of |C - C_d(t)|^2 over a period by Legendre collocation
     (:mod:`lib.optimal.collocation`) under F >= 0, F <= F_max and |beta| <= beta_max, with X(T) =

@@ -387,7 +387,9 @@ def _check_tracker_wrong_model() -> Outcome:
                    "largest RMS distance (m) of the tracker's orbit on a plant 10 % off or pushed by 0.2 N",
                    f"{len(w)} cases (m, I_C, c, c_phi, a each 10 % high and low in the plant, a 0.2 N push; the "
                    "plan and the gain nominal; 4 N and 30 deg + 4 N, with and without the margin), each decided "
-                   f"on the verdict's two maps: periodic at {int((w.regime == 'periodic').sum())}",
+                   f"on the verdict's two maps: periodic at {int((w.regime == 'periodic').sum())}; the paper's "
+                   f"start reaches the orbit at {int(w.paper_start_reached.sum())}, and after the entry planned "
+                   f"on the nominal model at {int(w.entry_reached.sum())}",
                    merit_kind=Kind.FOUND.value)
 
 

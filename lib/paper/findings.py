@@ -109,6 +109,9 @@ LABELS = {
         "mg_cap_cost_rms": ("m", "RMS"), "mg_e2_ratio": ("times", "least possible"),
         "mg_e1_ratio": ("times", "least possible"), "entry_reached": ("settings", "entry"),
         "entry_periods": ("periods", "entry"),
+        "em_heading": ("rad", "turned"), "em_pos": ("m", "moved"), "em_m": ("%", "mass"),
+        "basin_setting": ("", "measured at"), "mg_wm_cap_0_entry": ("plants", "paper's start"),
+        "mg_wm_cap_0_n": ("plants", "wrong and pushed"), "mg_wm_cap_1_entry": ("plants", "with the margin"),
     },
 }
 
