@@ -41,6 +41,7 @@ from scipy.optimize import minimize_scalar
 
 from ..dynamics.orbits import floquet_multipliers, newton
 from ..machinery import checks
+from ..machinery.summary import Summarised
 from ..params import Body
 from ..trajectories import KINEMATICS, POSITIONS, heading_turns, make
 
@@ -201,8 +202,8 @@ def exact_peak_force(body: Body, R, Theta, *, kind: str = "eight"):
     return float(out) if (r_scalar and t_scalar) else out
 
 
-@dataclass(frozen=True)
-class CapBound:
+@dataclass(frozen=True, repr=False)
+class CapBound(Summarised):
     """The least error of C's tracking under the cap |F_w| <= F_max, bracketed.
 
     max_error (m): certified lower bound on the largest distance |C - C_d| over a period (the

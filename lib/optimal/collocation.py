@@ -39,6 +39,7 @@ from scipy.optimize import minimize_scalar
 
 from ..angles import wrap_angle
 from ..machinery import checks
+from ..machinery.summary import Summarised
 from ..model import config_from_state, state_from_config
 from ..params import PAPER_DZ0, PAPER_Z0, Body
 from ..percussion import paper_steady
@@ -298,8 +299,8 @@ def entry_transcription(body: Body, nodes: int, degree: int) -> Transcription:
     return Transcription(nodes=N, degree=d, block=block, ng=int(nlp["g"].numel()), solver=solver)
 
 
-@dataclass(frozen=True)
-class Entry:
+@dataclass(frozen=True, repr=False)
+class Entry(Summarised):
     """An entry manoeuvre (:func:`entry_motion`): inputs F (N), beta (rad) held on each interval
     of [0, periods T]; C's RMS and largest distance from the path over it (m, at the collocation
     points, ``path`` (M, 3): t (s), x, y (m) there); ``end``, the state its integrated inputs reach
