@@ -367,7 +367,7 @@ def convergence_table(conv: pd.DataFrame) -> pd.DataFrame:
 def motions_table(frame: pd.DataFrame, rich: pd.DataFrame) -> pd.DataFrame:
     """The best motions found under the angle limits against the mesh (:func:`mesh_study`) as the page
     shows them: RMS distance at each mesh (m, rounded up: motions found), its Richardson estimate
-    (:func:`richardson`, "± its error"; "none" where the force grows), the largest distance at the
+    (:func:`richardson`, "± its error"; "none" without a cap), the largest distance at the
     finest mesh (m, up), the peak force at each mesh (N), the start that won at the coarsest and
     how many starts end within :data:`lib.optimal.motion.START_TIE` of it.
 
@@ -386,7 +386,7 @@ def motions_table(frame: pd.DataFrame, rich: pd.DataFrame) -> pd.DataFrame:
     for s, f in frame.groupby("setting", sort=False):
         r, first = est.loc[s], f.iloc[0]
         rows.append({"setting": s, f"RMS at {nodes} intervals (m)": " / ".join(_up(v, ".4f") for v in f.rms_integrated),
-                     "RMS, Richardson estimate (m)": "none (force grows)" if pd.isna(r.estimate) else
+                     "RMS, Richardson estimate (m)": "none (no cap)" if pd.isna(r.estimate) else
                      f"{round_directed(r.estimate, '.4f', 'nearest')} ± {_up(r.error, '.4f')}",
                      f"largest at {f.nodes.iloc[-1]} (m)": _up(f.max_error.iloc[-1], ".4f"),
                      f"peak F at {nodes} (N)": " / ".join(f"{v:.2f}" for v in f.F_peak),
