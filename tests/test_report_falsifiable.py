@@ -376,7 +376,20 @@ def test_cap_bound_row_fails_with_each_clause(monkeypatch, kw, status):
 ])
 def test_angle_optimum_row_fails_with_each_clause(monkeypatch, kw, ret, status):
     assert _status(monkeypatch, "angle-optimum", cached=_cached_study(_ch8_study(**kw)),
-                   verify_motion=lambda body, m: ret) == status
+                   verify_motion=lambda body, m: ret,
+                   motion_meshes=lambda body, gains: {"frame": _ch8_meshes(ret=ret, **kw)}) == status
+
+
+def _ch8_meshes(*, ret, motion_rms=None):
+    """Chapter 8's mesh study of the angle-limited settings: a coarser mesh that meets every clause,
+    and the finest, which the row reads, met or broken as ``motion_rms`` and ``ret`` say."""
+    rows = []
+    for i, (a, c) in enumerate(_SETTINGS):
+        if a is not None:
+            base = dict(setting=f"s{i}", angle_deg=a, cap=np.nan if c is None else c)
+            rows.append(dict(base, nodes=160, rms_integrated=0.06, return_position=1e-9))
+            rows.append(dict(base, nodes=320, rms_integrated=(motion_rms or {}).get(i, 0.05), return_position=ret))
+    return pd.DataFrame(rows)
 
 
 @pytest.mark.parametrize("kw, status", [

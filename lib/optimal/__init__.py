@@ -6,7 +6,8 @@
   tracking of C needs (:func:`exact_peak_force`);
 * :mod:`.motion` (with :mod:`.collocation`): the best periodic motion found under an angle limit,
   with or without the cap, by direct collocation of the full model (2)-(4) (CasADi and IPOPT),
-  verified by integrating its inputs (:func:`periodic_motion`, :func:`verify_motion`);
+  verified by integrating its inputs (:func:`periodic_motion`, :func:`verify_motion`), refined
+  through the meshes and extrapolated in :mod:`.study` (``mesh_study``, ``richardson``);
 * :mod:`.tracker`: a controller that reaches such a motion, the periodic LQR of its
   linearisation with the limits enforced in the loop (:func:`track_motion`), decided by the
   book's procedure in :mod:`.verdict` (:func:`motion_verdict`, its basin, and the verdict of

@@ -1,23 +1,20 @@
 """The best periodic motions of the body on the circle (27) and the eight (28) under the
 paper's limits (Sec. 5): how close to the path any controller can keep C.
 
-The full model (2)-(4) with F >= 0 (<= F_max if given) and |beta| <= beta_max (if given) runs a
-periodic motion X(T) = X(0) + (0, 0, 2 pi n, 0, 0, 0) (T = 2 pi / Theta; n = 0 on the eight,
-1 on the circle); :func:`periodic_motion` finds one that minimises the RMS distance of C from
-C_d(t), by direct collocation solved by IPOPT (:mod:`lib.optimal.collocation`) from several
-starts (the problem is not convex; the result is the best found), :func:`verify_motion` and
-:func:`return_errors` integrate its inputs to check that it is a motion of the model, and
-:func:`held_force_motion` makes the convex bound's achieved motions motions of the full model.
+:func:`periodic_motion` finds a periodic motion X(T) = X(0) + (0, 0, 2 pi n, 0, 0, 0) of (2)-(4)
+(T = 2 pi / Theta; n = 0 on the eight, 1 on the circle) under F >= 0, F <= F_max, |beta| <= beta_max
+that minimises the RMS distance of C from C_d(t), by collocation solved by IPOPT
+(:mod:`lib.optimal.collocation`) from several starts (not convex: a best found); :func:`reintegrated`
+integrates its inputs, a motion of the model; :func:`held_force_motion` makes the convex bound's
+achieved motions motions of the full model.
 
 Defaults and cost: 80 intervals of degree-3 Legendre collocation (2080 unknowns), starts "paper",
 "force", "shifted+-" and, under a cap alone, "convex"; a solve takes about 0.3 to 1.3 s of CPU.
 The inputs are held in the body's frame on each interval, so the force turns with the heading
-within it; under the 4 N cap alone the heading turns by up to about 0.6 rad an interval at 80
-intervals, and the best found RMS error falls as h^2 with the mesh towards the convex optimum
-(0.0731, 0.0700, 0.0692 m at 80, 160, 320 intervals; at 80 every start, the convex one included, ties
-within :data:`START_TIE`: no other optimum is met, not a proof of none). Under an angle limit without a
-cap the optimum asks for force pulses that grow as the mesh refines: its RMS error moves by a few per
-cent between 40 and 160 intervals.
+within it: with a cap the best found RMS error falls as h^2 with the mesh (Chapter 8 refines each
+motion and extrapolates, :func:`lib.optimal.study.richardson`); without one the optimum asks for
+force pulses whose peak grows as the mesh refines. The starts meet one optimum at the meshes the
+book tries; that says no better one was met, not that none exists.
 """
 
 from __future__ import annotations
@@ -36,8 +33,8 @@ from ..trajectories import KINEMATICS, heading_turns, make
 from .bound import HEADING_SUBSTEPS, CapBound, _phi2, cap_bound, heading_orbit
 from .collocation import ACCEPTED, FREE_ANGLE, _bounds, _clip, _guess_start, _max_error, _start, tableau, transcription
 
-__all__ = ["PeriodicMotion", "periodic_motion", "verify_motion", "return_errors", "STARTS", "START_TIE", "MAX_NODES",
-           "FREE_ANGLE", "HeldForceMotion", "held_force_motion"]
+__all__ = ["PeriodicMotion", "periodic_motion", "verify_motion", "return_errors", "reintegrated", "STARTS",
+           "START_TIE", "MAX_NODES", "FREE_ANGLE", "HeldForceMotion", "held_force_motion"]
 
 #: the starts :func:`periodic_motion` knows ("shifted" is two solves, +- beta_max / 2; "convex"
 #: needs a cap)
@@ -51,6 +48,8 @@ MAX_NODES = 2000
 FREE_SHIFT = math.pi / 4
 #: how close (in intervals) to a node a time counts as the node
 NODE_SNAP = 1e-9
+#: Gauss-Legendre points an interval of :func:`reintegrated`'s RMS
+QUADRATURE = 6
 
 
 @dataclass(frozen=True)
@@ -160,11 +159,8 @@ class PeriodicMotion:
 
 
 def _check_limits(F_max, beta_max):
-    if F_max is not None:
-        F_max = checks.number("F_max", F_max, positive=True, unit="N")
-    if beta_max is not None:
-        beta_max = checks.number("beta_max", beta_max, positive=True, maximum=math.pi, unit="rad")
-    return F_max, beta_max
+    return (None if F_max is None else checks.number("F_max", F_max, positive=True, unit="N"),
+            None if beta_max is None else checks.number("beta_max", beta_max, positive=True, maximum=math.pi, unit="rad"))
 
 
 def _check_guess(guess, kind, R, Theta) -> tuple:
@@ -197,7 +193,6 @@ def _check_starts(starts, guesses, F_max, beta_max) -> tuple:
     if "convex" in starts and F_max is None:
         raise ValueError("starts entry 'convex' needs a force cap F_max (the convex problem is the cap's)")
     return tuple(dict.fromkeys(starts))
-
 
 
 @dataclass(frozen=True)
@@ -434,34 +429,32 @@ def _best(tr, jobs, par, F_max, beta_max) -> tuple[np.ndarray, np.ndarray, tuple
     return X, u, tuple(table)
 
 
-def _return_mismatch(body: Body, motion: PeriodicMotion, rtol, atol) -> np.ndarray:
-    """X(T) - X(0) - (0, 0, 2 pi n, 0, 0, 0) (6,) of a motion's inputs integrated over one period."""
+def _return_mismatch(body: Body, motion: PeriodicMotion, rtol, atol) -> tuple[np.ndarray, float]:
+    """X(T) - X(0) - (0, 0, 2 pi n, 0, 0, 0) (6,) of a motion's inputs integrated over one period, and
+    the RMS distance (m) of the integrated C from the path, by Gauss-Legendre quadrature of
+    :data:`QUADRATURE` points on each interval (the integrated motion is smooth within one)."""
     checks.instance("body", body, Body)
     checks.instance("motion", motion, PeriodicMotion)
-    rtol = checks.number("rtol", rtol, positive=True)
-    atol = checks.number("atol", atol, positive=True)
+    rtol, atol = checks.number("rtol", rtol, positive=True), checks.number("atol", atol, positive=True)
     z0, dz0 = motion.state(0.0)
-    q = state_from_config(z0, dz0)
-    h = motion.period / motion.nodes
+    q, sq = state_from_config(z0, dz0), 0.0
+    h, ref = motion.period / motion.nodes, make(motion.kind, motion.R, motion.Theta)
+    s, w = np.polynomial.legendre.leggauss(QUADRATURE)
+    te = h * (s + 1) / 2
     for k in range(motion.nodes):
-        F, beta = float(motion.F[k]), float(motion.beta[k])
-        _, qs = simulate_open_loop(body, lambda t, F=F: F, lambda t, b=beta: b, q, h, form="config",
-                                   t_eval=np.array([h]), rtol=rtol, atol=atol)
+        _, qs = simulate_open_loop(body, lambda t, F=float(motion.F[k]): F, lambda t, b=float(motion.beta[k]): b, q,
+                                   h, form="config", t_eval=np.r_[te, h], rtol=rtol, atol=atol)
+        sq += w @ ((qs[:-1, :2] - ref.z(motion.t[k] + te)[:, :2]) ** 2).sum(1) / 2
         q = qs[-1]
-    z1, dz1 = config_from_state(q)
-    X1 = np.concatenate([z1, dz1]) - np.concatenate([z0, dz0])
-    X1[2] -= 2 * np.pi * motion.turns
-    return X1
+    X1 = np.concatenate(config_from_state(q)) - np.concatenate([z0, dz0]) - [0, 0, 2 * np.pi * motion.turns, 0, 0, 0]
+    return X1, math.sqrt(sq / motion.nodes)
 
 
 def verify_motion(body: Body, motion: PeriodicMotion, *, rtol: float = 1e-10, atol: float = 1e-10) -> float:
-    """The return error of a motion's inputs integrated by the book's integrator.
-
-    Integrates the model (2)-(4) (:func:`lib.simulate.simulate_open_loop`, ``form="config"``)
-    under ``motion.inputs`` from ``motion.state(0)`` over one period, interval by interval
-    (each interval's inputs are constant, so the integrator never steps across a jump), and
-    returns max |X(T) - X(0) - (0, 0, 2 pi n, 0, 0, 0)| over the six state components
-    (:func:`return_errors` gives it per quantity, each in its unit).
+    """The return error of a motion's inputs integrated by the book's integrator: the model (2)-(4)
+    (:func:`lib.simulate.simulate_open_loop`, ``form="config"``) under ``motion.inputs`` from
+    ``motion.state(0)`` over one period, interval by interval (the inputs are constant on each,
+    so the integrator never steps across a jump); max |X(T) - X(0) - (0, 0, 2 pi n, 0, 0, 0)|.
 
     Parameters
     ----------
@@ -475,26 +468,33 @@ def verify_motion(body: Body, motion: PeriodicMotion, *, rtol: float = 1e-10, at
     Returns
     -------
     float
-        The return error, a max-norm over components in the state's own units (m, m, rad,
-        m/s, m/s, rad/s), not a physical length.
+        A max-norm over the six components in their own units (m, m, rad, m/s, m/s, rad/s), not
+        a length (:func:`reintegrated` gives it per quantity).
     """
-    return float(np.max(np.abs(_return_mismatch(body, motion, rtol, atol))))
+    return float(np.max(np.abs(_return_mismatch(body, motion, rtol, atol)[0])))
 
 
 def return_errors(body: Body, motion: PeriodicMotion, *, rtol: float = 1e-10, atol: float = 1e-10) -> dict:
-    """:func:`verify_motion`'s mismatch after one period, per quantity, each in its own unit.
+    """:func:`reintegrated` without its ``rms``: the mismatch after one period, per quantity.
 
-    Parameters
-    ----------
-    body, motion, rtol, atol
-        As in :func:`verify_motion`.
+    Returns
+    -------
+    dict
+        ``position`` (m), ``heading`` (rad), ``velocity`` (m/s), ``rate`` (rad/s).
+    """
+    return {k: v for k, v in reintegrated(body, motion, rtol=rtol, atol=atol).items() if k != "rms"}
+
+
+def reintegrated(body: Body, motion: PeriodicMotion, *, rtol: float = 1e-10, atol: float = 1e-10) -> dict:
+    """A motion's inputs integrated as by :func:`verify_motion`: the mismatch after a period per quantity,
+    and the RMS distance of the integrated C from the path (a motion of the model's: a best found's value).
 
     Returns
     -------
     dict
         ``position`` |dC| (m), ``heading`` |d phi| (rad), ``velocity`` |dC'| (m/s), ``rate``
-        |d phi'| (rad/s).
+        |d phi'| (rad/s); ``rms`` (m).
     """
-    d = _return_mismatch(body, motion, rtol, atol)
+    d, rms = _return_mismatch(body, motion, rtol, atol)
     return dict(position=float(np.hypot(d[0], d[1])), heading=float(abs(d[2])),
-                velocity=float(np.hypot(d[3], d[4])), rate=float(abs(d[5])))
+                velocity=float(np.hypot(d[3], d[4])), rate=float(abs(d[5])), rms=rms)

@@ -2,8 +2,8 @@
 :func:`lib.machinery.cache.cached`, with the same arguments): the bound under a force cap over
 caps and meshes (:func:`cap_sweep`, :func:`cap_convergence`), the best periodic motions found under
 the angle limits by continuation from the cap's own optimum (:func:`limit_motions`), their
-mesh study (:func:`motion_convergence`) and a multi-start study of one setting
-(:func:`multistart`).
+refinement and extrapolation (:func:`mesh_study`, :func:`richardson`)
+and a multi-start study of one setting (:func:`multistart`).
 """
 
 from __future__ import annotations
@@ -19,14 +19,14 @@ from ..machinery.kinds import round_directed
 from ..params import Body
 from .bound import cap_bound, exact_peak_force
 from .collocation import ACCEPTED, entry_motion
-from .motion import START_TIE, PeriodicMotion, periodic_motion, return_errors
+from .motion import START_TIE, PeriodicMotion, periodic_motion, reintegrated
 from .tracker import periodic_lqr
 from .verdict import motion_verdict, offset_starts
 
-__all__ = ["PAPER_CAP", "CHAPTER_ANGLES_DEG", "SETTINGS", "CAP_REFINED", "MULTISTART_SEED", "setting_label",
-           "cap_sweep", "cap_convergence", "limit_motions", "motion_convergence", "multistart", "convergence_table",
-           "motions_table", "mesh_table", "multistart_summary", "multistart_optima", "cap_alone_chain",
-           "entry_rows", "entry_table", "entry_basin"]
+__all__ = ["PAPER_CAP", "CHAPTER_ANGLES_DEG", "SETTINGS", "CAP_REFINED", "MULTISTART_SEED", "MULTISTART_FINE_RANDOM",
+           "setting_label", "cap_sweep", "cap_convergence", "limit_motions", "mesh_study", "richardson",
+           "multistart", "convergence_table", "motions_table", "multistart_summary", "multistart_optima",
+           "cap_alone_chain", "entry_rows", "entry_table", "entry_basin"]
 
 #: the paper's force cap (N), Fig. 4
 PAPER_CAP = 4.0
@@ -35,12 +35,15 @@ CHAPTER_ANGLES_DEG = (90, 60, 45, 30)
 #: the limit settings of Chapter 8's comparison; (angle limit (deg) or None, cap (N) or None)
 SETTINGS = ((None, PAPER_CAP),) + tuple((a, None) for a in CHAPTER_ANGLES_DEG[::-1]) \
     + tuple((a, PAPER_CAP) for a in CHAPTER_ANGLES_DEG[::-1])
-#: the meshes (intervals a period) the cap-alone optimum is refined through after the default one:
-#: its inputs are held in the body's frame while the heading swings within an interval, so its RMS
-#: error falls as h^2 towards the convex optimum (at 320 within the bound's bracket at 80 nodes)
+#: the meshes (intervals a period) every motion is refined through after the default one: its inputs
+#: are held in the body's frame while the heading swings within an interval, so under a cap its RMS
+#: error falls as h^2 (the cap alone's towards the convex optimum, in the bound's bracket at 320)
 CAP_REFINED = (160, 320)
 #: the seed of :func:`multistart`'s random headings
 MULTISTART_SEED = 20141
+#: random headings of Chapter 8's multi-start on its finest mesh (each about 1.4 s of CPU there;
+#: tests/test_optimal_motion.py runs the full 16 of :func:`multistart`'s default)
+MULTISTART_FINE_RANDOM = 4
 
 
 def setting_label(angle_deg, cap) -> str:
@@ -136,7 +139,7 @@ def cap_alone_chain(body: Body, R: float, Theta: float, F_max: float, *, kind: s
                     refine=CAP_REFINED) -> tuple:
     """The best motion found under the cap alone (:func:`lib.optimal.motion.periodic_motion`): at
     ``nodes`` intervals from every start (the convex one included), then through the meshes
-    ``refine``, each from the one before alone (as :func:`motion_convergence`).
+    ``refine``, each from the one before alone (as :func:`mesh_study`).
 
     Returns
     -------
@@ -147,10 +150,15 @@ def cap_alone_chain(body: Body, R: float, Theta: float, F_max: float, *, kind: s
     F_max = checks.number("F_max", F_max, positive=True, unit="N")
     nodes = checks.integer("nodes", nodes, minimum=8)
     refine = [checks.integer("refine", n, minimum=nodes + 1) for n in refine]
-    chain = [periodic_motion(body, R, Theta, kind=kind, F_max=F_max, nodes=nodes)]
+    return _refined(body, periodic_motion(body, R, Theta, kind=kind, F_max=F_max, nodes=nodes), refine)
+
+
+def _refined(body: Body, m: PeriodicMotion, refine) -> tuple:
+    """``m`` and its optimum refined through the meshes ``refine``, each from the one before alone."""
+    chain = [m]
     for n in refine:
-        chain.append(periodic_motion(body, R, Theta, kind=kind, F_max=F_max, nodes=n, starts=(),
-                                     guess={f"from {chain[-1].nodes} intervals": chain[-1]}))
+        chain.append(periodic_motion(body, m.R, m.Theta, kind=m.kind, F_max=m.F_max, beta_max=m.beta_max, nodes=n,
+                                     starts=(), guess={f"from {chain[-1].nodes} intervals": chain[-1]}))
     return tuple(chain)
 
 
@@ -203,14 +211,10 @@ def multistart(body: Body, R: float, Theta: float, beta_max: float, F_max: float
         The body.
     R, Theta : float
         The path (m, rad/s).
-    beta_max : float
-        Angle limit (rad).
-    F_max : float or None
-        Force cap (N); None for none.
-    n_random : int
-        Random headings, >= 1.
-    seed : int
-        The generator's seed.
+    beta_max, F_max : float
+        Angle limit (rad), force cap (N; None for none).
+    n_random, seed : int
+        Random headings (>= 1), the generator's seed.
     nodes : int
         Intervals a period.
     kind : str
@@ -265,49 +269,77 @@ def multistart_summary(frame: pd.DataFrame, tol: float = 1e-4) -> dict:
                 near_best=int((ok <= best + tol).sum()))
 
 
-def motion_convergence(body: Body, R: float, Theta: float, beta_max: float, F_max: float | None,
-                       nodes=(40, 80, 160), *, kind: str = "eight") -> pd.DataFrame:
-    """The best motion under (beta_max (rad), F_max (N or None)) against the mesh: its RMS and
-    largest distance (m), its peak force (N), and the return error of its inputs integrated by
-    the book's integrator over one period, per quantity (:func:`lib.optimal.motion.return_errors`:
-    position (m), heading (rad), velocity (m/s), rate (rad/s)).
-
-    Mesh refinement of one optimum: the coarsest mesh is solved from every start of
-    :func:`lib.optimal.motion.periodic_motion`, each finer one from the optimum of the mesh
-    before it alone (interpolated onto the finer mesh), so that every row refines the same
-    motion instead of letting the starts choose among local optima anew.
+def mesh_study(body: Body, motions: dict, refine=CAP_REFINED) -> dict:
+    """Each motion of :func:`limit_motions` with an angle limit refined through the meshes ``refine``
+    (intervals a period, increasing, each above the motion's), each solved from the one before
+    alone, interpolated (as :func:`cap_alone_chain`: the same optimum refined, not chosen anew), and
+    each re-integrated from its inputs by the book's integrator (:func:`lib.optimal.motion.reintegrated`).
 
     Parameters
     ----------
     body : Body
-        The body.
-    R, Theta : float
-        The path (m, rad/s).
-    beta_max : float
-        Angle limit (rad).
-    F_max : float or None
-        Force cap (N); None for none.
-    nodes : sequence of int
-        The meshes (intervals a period), increasing, each >= 8.
-    kind : str
-        ``"eight"`` or ``"circle"``.
+        The body the motions were solved for.
+    motions : dict
+        (angle limit in deg or None, cap in N or None) -> PeriodicMotion.
+    refine : sequence of int
+        The finer meshes.
+
+    Returns
+    -------
+    dict
+        ``chains``: (angle limit, cap) -> tuple of PeriodicMotion, one a mesh, the given first;
+        ``frame``: one row a (setting, mesh): setting, angle_deg, cap, nodes, rms_error (the
+        collocation's), rms_integrated (the integrated motion's), max_error (m), F_peak (N),
+        return_position (m), return_heading (rad), return_velocity (m/s), return_rate (rad/s),
+        best_start, starts_at (starts within START_TIE of the optimum) and starts.
+    """
+    checks.instance("body", body, Body)
+    if not isinstance(motions, dict) or not all(isinstance(m, PeriodicMotion) for m in motions.values()):
+        raise TypeError("motions must be a dict (angle limit, cap) -> PeriodicMotion (limit_motions' result)")
+    limited = {key: m for key, m in motions.items() if key[0] is not None}
+    refine = [checks.integer("refine", n, minimum=max(m.nodes for m in limited.values()) + 1) for n in refine]
+    if any(b <= a for a, b in zip(refine, refine[1:])):
+        raise ValueError(f"refine must increase (each mesh refines the one before), got {refine}")
+    chains, rows = {key: _refined(body, m, refine) for key, m in limited.items()}, []
+    for (a, c), chain in chains.items():
+        for m in chain:
+            r = reintegrated(body, m)
+            rows.append(dict(setting=setting_label(a, c), angle_deg=a, cap=c, nodes=m.nodes, rms_error=m.rms_error,
+                             rms_integrated=r.pop("rms"), max_error=m.max_error, F_peak=float(m.F.max()),
+                             **{f"return_{q}": e for q, e in r.items()}, best_start=m.best_start,
+                             starts_at=sum(x <= m.rms_error + START_TIE for _, x, _ in m.starts), starts=len(m.starts)))
+    return dict(chains=chains, frame=pd.DataFrame(rows))
+
+
+def richardson(frame: pd.DataFrame, order: float = 2.0) -> pd.DataFrame:
+    """Richardson's extrapolation of each capped motion's integrated RMS (m) over :func:`mesh_study`'s
+    meshes (three or more, each twice the one before): e_h - (e_2h - e_h) / (2^p - 1) from the finest
+    pair; its error, the larger of that correction and its change from the pair before. Without a
+    cap the optimum's force grows with the mesh: no limit is estimated (NaN).
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        :func:`mesh_study`'s frame.
+    order : float
+        p, the order of the RMS error in h.
 
     Returns
     -------
     pandas.DataFrame
-        Columns nodes, rms_error, max_error, F_peak, return_position (m), return_heading (rad),
-        return_velocity (m/s), return_rate (rad/s).
+        One row a setting: setting, nodes (the finest), best (its integrated RMS, m), estimate and
+        error (m), ratio (the finest three meshes' differences' ratio, 2^p where the order holds).
     """
-    R, Theta = _check(body, R, Theta, kind)
-    meshes = [checks.integer("nodes", n, minimum=8) for n in np.atleast_1d(nodes)]
-    if any(b <= a for a, b in zip(meshes, meshes[1:])):
-        raise ValueError(f"nodes must increase (each mesh refines the one before), got {meshes}")
-    rows, m = [], None
-    for n in meshes:
-        opts = {} if m is None else dict(starts=(), guess=m)
-        m = periodic_motion(body, R, Theta, kind=kind, F_max=F_max, beta_max=beta_max, nodes=n, **opts)
-        rows.append(dict(nodes=n, rms_error=m.rms_error, max_error=m.max_error, F_peak=float(m.F.max()),
-                         **{f"return_{q}": e for q, e in return_errors(body, m).items()}))
+    rows, q = [], 2.0 ** checks.number("order", order, positive=True) - 1
+    for s, f in frame.groupby("setting", sort=False):
+        e, n = f.rms_integrated.to_numpy(), f.nodes.to_numpy()
+        if len(e) < 3 or np.any(n[1:] != 2 * n[:-1]):
+            raise ValueError(f"frame: setting {s!r} needs three or more meshes, each twice the one before, got {n}")
+        est, prev = e[-1] - (e[-2] - e[-1]) / q, e[-2] - (e[-3] - e[-2]) / q
+        capped = not pd.isna(f.cap.iloc[0])
+        rows.append(dict(setting=s, nodes=int(n[-1]), best=e[-1], estimate=est if capped else math.nan,
+                         error=max(abs(e[-1] - est), abs(est - prev)) if capped else math.nan,
+                         ratio=(e[-3] - e[-2]) / (e[-2] - e[-1])))
     return pd.DataFrame(rows)
 
 
@@ -332,52 +364,34 @@ def convergence_table(conv: pd.DataFrame) -> pd.DataFrame:
                          "duality gap (m)": conv.gap.map("{:.0e}".format)})
 
 
-def motions_table(motions: dict) -> pd.DataFrame:
-    """The best motions found by :func:`limit_motions` under the angle limits: angle limit (deg),
-    cap, RMS and largest distance (m, four decimals, rounded up: values of motions found), peak
-    force (N, two), the start that won and
-    how many of the starts end within :data:`lib.optimal.motion.START_TIE` of it.
+def motions_table(frame: pd.DataFrame, rich: pd.DataFrame) -> pd.DataFrame:
+    """The best motions found under the angle limits against the mesh (:func:`mesh_study`) as the page
+    shows them: RMS distance at each mesh (m, rounded up: motions found), its Richardson estimate
+    (:func:`richardson`, "± its error"; "none" without a cap), the largest distance at the
+    finest mesh (m, up), the peak force at each mesh (N), the start that won at the coarsest and
+    how many starts end within :data:`lib.optimal.motion.START_TIE` of it.
 
     Parameters
     ----------
-    motions : dict
-        (angle deg or None, cap or None) -> PeriodicMotion.
+    frame, rich : pandas.DataFrame
+        :func:`mesh_study`'s and :func:`richardson`'s frames.
 
     Returns
     -------
     pandas.DataFrame
-        One row a motion with an angle limit, formatted.
+        One row a setting, formatted.
     """
-    rows = [{"angle limit (deg)": a, "cap (N)": "none" if c is None else f"{c:g}",
-             "RMS distance (m)": _up(m.rms_error, ".4f"), "largest (m)": _up(m.max_error, ".4f"),
-             "peak F (N)": f"{float(m.F.max()):.2f}", "best start": m.best_start,
-             "starts at it": f"{sum(r <= m.rms_error + START_TIE for _, r, _ in m.starts)} of {len(m.starts)}"}
-            for (a, c), m in motions.items() if a is not None]
+    nodes, est, rows = " / ".join(str(n) for n in frame.nodes[frame.setting == frame.setting.iloc[0]]), \
+        rich.set_index("setting"), []
+    for s, f in frame.groupby("setting", sort=False):
+        r, first = est.loc[s], f.iloc[0]
+        rows.append({"setting": s, f"RMS at {nodes} intervals (m)": " / ".join(_up(v, ".4f") for v in f.rms_integrated),
+                     "RMS, Richardson estimate (m)": "none (no cap)" if pd.isna(r.estimate) else
+                     f"{round_directed(r.estimate, '.4f', 'nearest')} ± {_up(r.error, '.4f')}",
+                     f"largest at {f.nodes.iloc[-1]} (m)": _up(f.max_error.iloc[-1], ".4f"),
+                     f"peak F at {nodes} (N)": " / ".join(f"{v:.2f}" for v in f.F_peak),
+                     f"best start at {first.nodes}": f"{first.best_start} ({first.starts_at} of {first.starts})"})
     return pd.DataFrame(rows)
-
-
-def mesh_table(conv: dict) -> pd.DataFrame:
-    """:func:`motion_convergence`'s frames by cap, as the page shows them: cap, intervals, RMS
-    distance (m, rounded up), peak force (N), and the return error per quantity: position (m), heading (rad),
-    velocity (m/s), rate (rad/s).
-
-    Parameters
-    ----------
-    conv : dict
-        Cap (N or None) -> frame of :func:`motion_convergence`.
-
-    Returns
-    -------
-    pandas.DataFrame
-        Formatted rows.
-    """
-    return pd.concat([pd.DataFrame({"cap": "none" if c is None else f"{c:g} N", "intervals": f.nodes,
-                                    "RMS distance (m)": f.rms_error.map(lambda v: _up(v, ".4f")),
-                                    "peak F (N)": f.F_peak.map("{:.2f}".format),
-                                    **{f"return, {q} ({u})": f[f"return_{q}"].map("{:.0e}".format)
-                                       for q, u in (("position", "m"), ("heading", "rad"), ("velocity", "m/s"),
-                                                    ("rate", "rad/s"))}})
-                      for c, f in conv.items()], ignore_index=True)
 
 
 def entry_rows(body: Body, motions: dict, *, periods: int = 2, steps: int = 2,

@@ -101,7 +101,8 @@ LABELS = {
     },
     "chapters/08_optimal": {
         "b4_max": ("m", "lower bound"), "b4_max_ach": ("m", "motion"), "p4_max": ("m", "paper's law"),
-        "p4_ratio": ("times", "least possible"), "bf30c_rms": ("m", "RMS"), "paper30c_rms": ("m", "RMS"),
+        "p4_ratio": ("times", "least possible"), "bf30c_rms": ("m", "RMS"), "bf30c_rich": ("m", "Richardson"),
+        "paper30c_rms": ("m", "RMS"),
         "paper30c_ratio": ("times", "as much"), "opt_periodic": ("settings", "periodic orbit"),
         "opt_n": ("settings", "periodic orbit"), "opt_paper_reached": ("settings", "paper's start"),
         "opt_paper_undecided": ("settings", "undecided"),

@@ -20,7 +20,7 @@ from ..limits.torus import NS_ANGLE_DEG, NS_START_CAP, torus_birth
 from ..limits.confirm import confirmed_limit_verdicts
 from ..machinery.cache import cached
 from ..optimal.compare import limits_study
-from ..optimal.study import entry_rows
+from ..optimal.study import entry_rows, mesh_study
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from ..percussion.full_loop import full_loop_verdicts, grid_sample
 from ..simulate import OPEN_LOOP_HORIZON, Integration, open_loop_comparison, simulate
@@ -31,7 +31,7 @@ from ..trajectories import circle, eight
 __all__ = ["R0", "THETA0", "FIG4_CAP", "SWEEP_DEG", "CHAOS_DEG", "LYAPUNOV_DEG", "HORIZONS", "MIRROR_OFFSETS_DEG",
            "fig4_run", "angle_sweep", "chaos_row", "torus", "lyapunov_convergence", "mirror_starts",
            "mirror_attractors", "wrong_model", "circle_run", "full_loop_sample", "limits_comparison", "entries",
-           "open_loop_deviations", "open_loop_gap"]
+           "motion_meshes", "open_loop_deviations", "open_loop_gap"]
 
 #: the paper's circle (its Table), and Chapter 3's eight, in m and rad/s
 R0, THETA0 = 2.0, math.pi / 4
@@ -243,6 +243,28 @@ def limits_comparison(body: Body, gains: Gains) -> dict:
         The study.
     """
     return cached(limits_study, body, gains, R0, THETA0)
+
+
+def _motion_meshes(body: Body, gains: Gains) -> dict:
+    return mesh_study(body, limits_comparison(body, gains)["motions"])
+
+
+def motion_meshes(body: Body, gains: Gains) -> dict:
+    """Chapter 8's best motions found under the angle limits, refined through the meshes and
+    re-integrated (:func:`lib.optimal.study.mesh_study` of :func:`limits_comparison`'s motions),
+    computed once per build.
+
+    Parameters
+    ----------
+    body, gains : Body, Gains
+        The body and the gains of (23).
+
+    Returns
+    -------
+    dict
+        ``chains`` and ``frame``, as :func:`lib.optimal.study.mesh_study` returns them.
+    """
+    return cached(_motion_meshes, body, gains)
 
 
 def _entry_rows(body: Body, gains: Gains) -> pd.DataFrame:
