@@ -96,7 +96,7 @@ def test_honest_errors_from_six_batches_lean_by_one_over_c4():
     K, B = 40_000, 6
     est, se = iid_batch_runs(K, B, seed=2)
     r = cal.ensemble_ratio(est, se)
-    assert abs(r["ratio"] - 1 / c4(B)) < 4 / math.sqrt(2 * K) / c4(B)     # the ratio's spread 1/sqrt(2K)
+    assert abs(r["ratio"] - bl.honest_lean(B)) < 4 / math.sqrt(2 * K) / c4(B)     # its spread 1/sqrt(2K)
     assert abs(r["honest"] - 1 / c4(B)) < 4 / math.sqrt(2 * K)
     assert r["lo"] > 1.0                                                   # an honest error, yet clearly above 1
 
@@ -187,3 +187,10 @@ def test_the_borderline_study_runs_each_point_over_the_horizon_its_verdict_rests
     assert (above.early == 0).all()                         # the longer run has no early exit, as confirm_lost's
     assert set(got.estimator) == {"exponent", "drift"} and (got.free <= 6).all() and (got.K <= got.free).all()
     assert (got.honest >= 1.0).all()                        # sqrt(mean s^2) >= mean s
+
+
+def test_the_honest_lean_is_one_over_c4():
+    assert bl.honest_lean(6) == pytest.approx(1 / c4(6), rel=1e-12)
+    assert bl.honest_lean(np.array([25, 10 ** 6])) == pytest.approx([1 / c4(25), 1.0], rel=1e-6)
+    with pytest.raises(ValueError, match="batches"):
+        bl.honest_lean(1)
