@@ -194,3 +194,15 @@ def test_the_honest_lean_is_one_over_c4():
     assert bl.honest_lean(np.array([25, 10 ** 6])) == pytest.approx([1 / c4(25), 1.0], rel=1e-6)
     with pytest.raises(ValueError, match="batches"):
         bl.honest_lean(1)
+
+
+def test_the_borderline_table_has_a_row_a_point_and_a_column_an_estimator():
+    study = pd.DataFrame([dict(test="lost", side="above", setting="P", z=3.4, horizon=1200, free=64, early=0,
+                               estimator=e, ratio=r, lo=r - 0.1, hi=r + 0.2)
+                          for e, r in (("exponent", 1.0), ("drift", 0.95))])
+    got = bl.borderline_table(study)
+    assert got.columns.tolist() == ["line, side", "point", "z (errors)", "horizon (periods)", "starts: no orbit, early",
+                                    "exponent", "drift"]
+    assert got.iloc[0].tolist() == ["lost, above", "P", "3.40", 1200, "64, 0", "1 (0.9-1.2)", "0.95 (0.85-1.15)"]
+    with pytest.raises(ValueError, match="missing columns"):
+        bl.borderline_table(study.drop(columns=["early"]))

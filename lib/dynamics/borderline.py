@@ -318,9 +318,10 @@ def verdict_changes(frame: pd.DataFrame, sigmas: float = SIGMAS) -> dict:
 
 def borderline_table(study: pd.DataFrame) -> pd.DataFrame:
     """:func:`borderline_study` as the Methods page shows it: one row a point, the line it lies
-    near (test), its side, the map's statistic (standard errors), the horizon (periods), the starts
-    that reach no orbit and how many of them left the Lyapunov run early, and for the exponent and
-    the drift "ratio (interval)", the ratio of the spread over the starts to the mean error.
+    near (test) and its side, the point, the map's statistic (standard errors), the horizon
+    (periods), the starts that reach no orbit and how many of them left the Lyapunov run early,
+    and for the exponent and the drift "ratio (interval)", the ratio of the spread over the starts
+    to the mean error.
 
     Parameters
     ----------
@@ -340,8 +341,9 @@ def borderline_table(study: pd.DataFrame) -> pd.DataFrame:
     keys = ["test", "side", "setting"]
     wide = study.assign(cell=cell).pivot(index=keys, columns="estimator", values="cell")
     first = study.drop_duplicates(keys).set_index(keys)
-    out = pd.DataFrame({"z (errors)": [f"{z:.2f}" for z in first.z], "horizon (periods)": first.horizon,
-                        "starts, early": [f"{f}, {e}" for f, e in zip(first.free, first.early)]},
-                       index=first.index)
-    out = out.join(wide.reindex(first.index)[[c for c in ("exponent", "drift") if c in wide]].fillna("-"))
-    return out.reset_index().rename(columns={"test": "line", "side": "side of it"})
+    out = pd.DataFrame({"line, side": [f"{t}, {s}" for t, s, _ in first.index],
+                        "point": [p for _, _, p in first.index], "z (errors)": [f"{z:.2f}" for z in first.z],
+                        "horizon (periods)": first.horizon.to_numpy(),
+                        "starts: no orbit, early": [f"{f}, {e}" for f, e in zip(first.free, first.early)]})
+    cells = wide.reindex(first.index)[[c for c in ("exponent", "drift") if c in wide]].fillna("-")
+    return pd.concat([out, cells.reset_index(drop=True)], axis=1)
