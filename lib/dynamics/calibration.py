@@ -82,8 +82,12 @@ def ensemble_ratio(estimates, stderrs, level: float = LEVEL) -> dict:
     ``level`` confidence interval: (K - 1) s^2 / sigma^2 is chi-square on K - 1 degrees of
     freedom, so sigma lies in s sqrt((K - 1) / q_hi) .. s sqrt((K - 1) / q_lo) (the mean error,
     an average of K, taken as known). With K = 16 the interval is about [0.7, 1.5] times the
-    ratio, with K = 64 about [0.85, 1.2]. Returns a dict: K, mean, spread, stderr (the mean
-    error), ratio, lo, hi.
+    ratio, with K = 64 about [0.85, 1.2]. An honest error does not give a ratio of 1 exactly: an
+    error read from few batches is itself noisy, and its mean falls below the spread it
+    estimates (by c4(B), 0.95 for B = 6 batches; its square is unbiased), so the ratio an honest
+    error shows at these starts is ``honest`` = sqrt(mean s_k^2) / mean s_k (1 / c4(B) when the
+    starts' errors share one law). Returns a dict: K, mean, spread, stderr (the mean error),
+    ratio, lo, hi, honest.
 
     Parameters
     ----------
@@ -97,7 +101,7 @@ def ensemble_ratio(estimates, stderrs, level: float = LEVEL) -> dict:
     Returns
     -------
     dict
-        K, mean, spread, stderr, ratio, lo, hi.
+        K, mean, spread, stderr, ratio, lo, hi, honest.
     """
     x = np.asarray(estimates, dtype=float)
     s = np.asarray(stderrs, dtype=float)
@@ -112,7 +116,8 @@ def ensemble_ratio(estimates, stderrs, level: float = LEVEL) -> dict:
     ratio = spread / mean_se
     q_lo, q_hi = stats.chi2.ppf([(1 - level) / 2, (1 + level) / 2], K - 1)
     return dict(K=K, mean=float(x.mean()), spread=spread, stderr=mean_se, ratio=ratio,
-                lo=ratio * math.sqrt((K - 1) / q_hi), hi=ratio * math.sqrt((K - 1) / q_lo))
+                lo=ratio * math.sqrt((K - 1) / q_hi), hi=ratio * math.sqrt((K - 1) / q_lo),
+                honest=float(np.sqrt(np.mean(s ** 2)) / mean_se))
 
 
 def limit_ensemble(body: Body, gains: Gains, angle_deg: float, starts: int = LIMIT_STARTS, *,
@@ -183,12 +188,13 @@ def limit_ensemble(body: Body, gains: Gains, angle_deg: float, starts: int = LIM
 
 
 def rotation_ensemble(body: Body, R: float, Theta: float, starts: int = ROTATION_STARTS, *,
-                      seed: int = 0) -> pd.DataFrame:
+                      seed: int = 0, **options) -> pd.DataFrame:
     """``starts`` runs of the reduced rotation (32) on the eight at (R (m), Theta (rad/s)), from
     distinct random starts p(0) uniform in [-pi, pi) rad and dp/dt(0) uniform in
     [-Theta/2, Theta/2) rad/s (``seed``), each decided by
-    :func:`lib.rotation.verdicts.eight_rotation_sweep` with the map's defaults: the frame of
-    that function, one row per start (regime, lyapunov, lyapunov_stderr, slip, slip_stderr, ...).
+    :func:`lib.rotation.verdicts.eight_rotation_sweep` with the map's defaults (or ``options``,
+    the procedure's, e.g. a longer Lyapunov run): the frame of that function, one row per start
+    (regime, lyapunov, lyapunov_stderr, slip, slip_stderr, ...).
 
     Parameters
     ----------
@@ -202,6 +208,8 @@ def rotation_ensemble(body: Body, R: float, Theta: float, starts: int = ROTATION
         Starts (>= 3).
     seed : int
         The seed of the starts.
+    **options
+        The procedure's options (:data:`lib.rotation.verdicts.VERDICT_DEFAULTS`).
 
     Returns
     -------
@@ -212,7 +220,7 @@ def rotation_ensemble(body: Body, R: float, Theta: float, starts: int = ROTATION
     Theta = checks.number("Theta", Theta, positive=True)
     K = checks.integer("starts", starts, minimum=3)
     p0, v0 = _rotation_starts(K, Theta, seed)
-    return eight_rotation_sweep(body, np.full(K, R), np.full(K, Theta), p0=p0, v0=v0)
+    return eight_rotation_sweep(body, np.full(K, R), np.full(K, Theta), p0=p0, v0=v0, **options)
 
 
 def _rotation_starts(K: int, Theta: float, seed: int) -> tuple[np.ndarray, np.ndarray]:
