@@ -10,6 +10,9 @@ A number the book prints is one of a few kinds (``Methods``, "A number and its k
   possible (rounded up), never called "the best";
 - **estimate**: a statistic of a run, written with its standard error (``0.30 ± 0.02``), the
   error rounded up;
+- **numerical estimate**: a deterministic computation that no method certifies (a Floquet
+  multiplier from finite differences), written with its stated error (``0.030 ± 0.021``): the
+  spread over the method's own choices (differencing steps, h and h / 2), the error rounded up;
 - **count**: an integer, of a stated total.
 
 The code that computes a number says its kind by wrapping it (:func:`lower_bound`,
@@ -27,8 +30,8 @@ from dataclasses import dataclass
 from decimal import ROUND_CEILING, ROUND_FLOOR, ROUND_HALF_EVEN, Decimal
 from enum import Enum
 
-__all__ = ["Kind", "Number", "exact", "lower_bound", "upper_bound", "best_found", "estimate", "count",
-           "round_directed", "MIME"]
+__all__ = ["Kind", "Number", "exact", "lower_bound", "upper_bound", "best_found", "estimate", "numerical",
+           "count", "round_directed", "MIME"]
 
 #: the MIME type under which a glued number carries its value and kind beside its text
 MIME = "application/vnd.korczak.number+json"
@@ -42,6 +45,7 @@ class Kind(str, Enum):
     UPPER = "certified upper bound"
     FOUND = "best found"
     ESTIMATE = "estimate"
+    NUMERICAL = "numerical estimate"
     COUNT = "count"
 
     @property
@@ -49,6 +53,9 @@ class Kind(str, Enum):
         """The kind's rounding, "down", "up" or "nearest"."""
         return {Kind.LOWER: "down", Kind.UPPER: "up", Kind.FOUND: "up"}.get(self, "nearest")
 
+
+#: the kinds written with an error beside them
+_WITH_ERROR = (Kind.ESTIMATE, Kind.NUMERICAL)
 
 _MODES = {"down": ROUND_FLOOR, "up": ROUND_CEILING, "nearest": ROUND_HALF_EVEN}
 
@@ -112,7 +119,8 @@ class Number:
     fmt : str
         Its format spec ('.4f', '.2e', '.3g'); a count ignores it.
     stderr : float or None
-        An estimate's standard error (same unit), required for an estimate and refused otherwise.
+        An estimate's standard error, or a numerical estimate's stated error (same unit), required
+        for those two kinds and refused otherwise.
     total : int or None
         A count's total, if it has one.
     """
@@ -137,8 +145,9 @@ class Number:
             object.__setattr__(self, "value", float(self.value))
             if self.total is not None:
                 raise ValueError(f"total: only a count has a total, not a {kind.value}")
-        if (kind is Kind.ESTIMATE) != (self.stderr is not None):
-            raise ValueError("stderr: an estimate carries its standard error, and only an estimate does")
+        if (kind in _WITH_ERROR) != (self.stderr is not None):
+            raise ValueError("stderr: an estimate carries its standard error (a numerical estimate its stated "
+                             "error), and only those do")
         if self.stderr is not None and not (math.isfinite(self.stderr) and self.stderr >= 0):
             raise ValueError(f"stderr: a finite non-negative number, got {self.stderr!r}")
 
@@ -147,11 +156,12 @@ class Number:
 
     def text(self) -> str:
         """The number as the page writes it: rounded as its kind says; an estimate as
-        ``value ± stderr`` (the error rounded up, the value to the error's last digit)."""
+        ``value ± stderr`` (the error rounded up, the value to the error's last digit), and so is
+        a numerical estimate with its stated error."""
         if self.kind is Kind.COUNT:
             return str(self.value)
         text = round_directed(self.value, self.fmt, self.kind.rounding)
-        if self.kind is Kind.ESTIMATE:
+        if self.kind in _WITH_ERROR:
             text += " ± " + round_directed(self.stderr, self.fmt, "up")
         return text
 
@@ -255,6 +265,29 @@ def estimate(value: float, stderr: float, fmt: str = ".2f") -> Number:
         The estimate.
     """
     return Number(value, Kind.ESTIMATE, fmt, stderr=float(stderr))
+
+
+def numerical(value: float, error: float, fmt: str = ".3f") -> Number:
+    """A numerical estimate that no method certifies (a Floquet multiplier from finite
+    differences), written ``value ± error``: ``error`` is the stated spread over the method's own
+    choices (differencing steps, the integrator's step), not a standard error of a sampled
+    statistic, and the value is no bound either way.
+
+    Parameters
+    ----------
+    value : float
+        The estimate.
+    error : float
+        Its stated error (>= 0, same unit).
+    fmt : str
+        The format spec of both.
+
+    Returns
+    -------
+    Number
+        The numerical estimate.
+    """
+    return Number(value, Kind.NUMERICAL, fmt, stderr=float(error))
 
 
 def count(n: int, total: int | None = None) -> Number:

@@ -169,7 +169,8 @@ def pushed_verdict(body: Body, motion, push, *, limits: Limits | None = None, lq
     starts = checks.array("starts", DEFAULT_STARTS if starts is None else starts, shape=(None, 6), nonempty=True)
     F_max, beta_max = _limits(limits, motion)
     x_star = _reference(motion, 0.0)[0]
-    ladder = _ladder(steps, len(_edges(motion, 0.0, motion.period)) - 1)
+    pieces = len(_edges(motion, 0.0, motion.period)) - 1
+    ladder = _ladder(steps, pieces)
     coarse = _pushed_map(lqr, F_max, beta_max, ladder[0][0], push)
     orb_c = _orbit(coarse, x_star, h)
     for j in range(1, len(ladder)):
@@ -179,7 +180,8 @@ def pushed_verdict(body: Body, motion, push, *, limits: Limits | None = None, lq
         if not (shift > ORBIT_SHIFT_TOL) or j == len(ladder) - 1:
             break
         coarse, orb_c = fine, orb_f
-    return _decide(orb_c, orb_f, coarse, fine, x_star, starts, periods, h, ladder[j - 1][0], shift)
+    return _decide(orb_c, orb_f, coarse, fine, x_star, starts, periods, h, ladder[j - 1][0], shift,
+                   refine=lambda s: _pushed_map(lqr, F_max, beta_max, s, push) if s * pieces <= checks.MAX_STEPS else None)
 
 
 def _orbit_measures(plant: Body, motion, limits: Limits, lqr: PeriodicLQR, x, push) -> dict:
