@@ -23,7 +23,7 @@ from lib.optimal import tracker
 from lib.optimal.loop import LoopVerdict, _disagreement
 from lib.optimal.motion import periodic_motion
 from lib.optimal.study import CHAPTER_ANGLES_DEG, PAPER_CAP
-from lib.optimal.verdict import (MULTIPLIER_ATOL, MULTIPLIER_TOL, floquet_estimate, motion_verdict,
+from lib.optimal.verdict import (MULTIPLIER_ATOL, MULTIPLIER_TOL, floquet_estimate, floquet_text, motion_verdict,
                                  multiplier_tolerance, multipliers_agree)
 from lib.params import Body
 
@@ -47,10 +47,17 @@ def test_a_numerical_estimate_needs_its_error_and_no_other_kind_takes_one():
             bad()
 
 
-def test_the_book_writes_every_multiplier_the_same_way():
-    # the table, the prose and the report all call floquet_estimate: one text for one value
+def test_the_book_writes_every_multiplier_the_same_way_to_its_errors_digits():
+    # the table, the prose and the report all call floquet_estimate: one text for one value, to
+    # the error's second significant digit, no coarser than 3 decimals, no finer than the value's 3 digits
     assert floquet_estimate(0.0301401, 0.022841).text() == "0.030 ± 0.023"
     assert floquet_estimate(0.0301401, 0.022841).kind is Kind.NUMERICAL
+    assert floquet_estimate(0.0027862, 0.0012575).text() == "0.0028 ± 0.0013"
+    assert floquet_estimate(0.00093383, 7.86e-7).text() == "0.000934 ± 0.000001"
+    assert floquet_estimate(0.181892, 0.006453).text() == "0.182 ± 0.007"
+    assert floquet_text(0.03, math.nan) == "-" and floquet_text(math.nan, 0.01) == "-"
+    with pytest.raises(ValueError, match="error"):
+        floquet_estimate(0.03, -1.0)
 
 
 # ---------------------------------------------------------------- the agreement test

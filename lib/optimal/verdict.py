@@ -62,8 +62,8 @@ from .tracker import (DEFAULT_STARTS, NEWTON_ITER, NEWTON_STALL, NEWTON_TOL, REA
                       periodic_lqr)
 
 __all__ = ["MotionVerdict", "motion_verdict", "basin", "offset_starts", "multipliers_agree", "multiplier_tolerance",
-           "floquet_estimate", "ORBIT_SHIFT_TOL", "MULTIPLIER_TOL", "MULTIPLIER_RTOL", "MULTIPLIER_ATOL",
-           "KINK_STEP", "RESOLVE", "FINE_RTOL"]
+           "floquet_estimate", "floquet_text", "largest_floquet", "ORBIT_SHIFT_TOL", "MULTIPLIER_TOL",
+           "MULTIPLIER_RTOL", "MULTIPLIER_ATOL", "KINK_STEP", "RESOLVE", "FINE_RTOL"]
 
 #: the most the orbit may move (max-norm, state units) when the step is halved, a tenth of the
 #: reach tolerance :data:`lib.optimal.tracker.REACH_TOL`, so that a start's distance to it is
@@ -129,18 +129,52 @@ class MotionVerdict:
 
 def floquet_estimate(value: float, error: float) -> Number:
     """A largest |Floquet multiplier| from differences as the book writes it, everywhere: a
-    numerical estimate ``value ± error`` (:func:`lib.machinery.kinds.numerical`, 3 decimals).
+    numerical estimate ``value ± error`` (:func:`lib.machinery.kinds.numerical`) to the decimal
+    of the error's second significant digit, at least 3 decimals and at most the value's third
+    significant digit: ``0.030 ± 0.023``, ``0.0028 ± 0.0013``, ``0.000934 ± 0.000001``.
 
     Parameters
     ----------
     value, error : float
-        |mu_1| and its stated error (:class:`MotionVerdict`).
+        |mu_1| and its stated error (:class:`MotionVerdict`), finite, >= 0.
 
     Returns
     -------
     Number
     """
-    return numerical(value, error, ".3f")
+    value, error = checks.number("value", value, nonnegative=True), checks.number("error", error, nonnegative=True)
+
+    def decimals(x, digits):
+        return digits - 1 - math.floor(math.log10(x)) if x > 0 else 3
+    return numerical(value, error, f".{max(3, min(decimals(error, 2), decimals(value, 3)))}f")
+
+
+def floquet_text(value: float, error: float) -> str:
+    """:func:`floquet_estimate`'s text, or "-" where the row has no multiplier or no error (no orbit)."""
+    ok = math.isfinite(value) and math.isfinite(error)
+    return floquet_estimate(value, error).text() if ok else "-"
+
+
+def largest_floquet(frame: pd.DataFrame) -> Number:
+    """The largest |mu_1| of a table's rows (columns ``floquet`` and ``floquet_error``, as
+    :func:`lib.optimal.compare.side_by_side` and :func:`lib.optimal.margins.tracked_case` give
+    them) with that row's error, as :func:`floquet_estimate` writes it: the page's prose, its
+    tables and the report print the same text.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        Rows with finite ``floquet``.
+
+    Returns
+    -------
+    Number
+    """
+    checks.instance("frame", frame, pd.DataFrame)
+    if not {"floquet", "floquet_error"} <= set(frame.columns) or not np.isfinite(frame.floquet).any():
+        raise ValueError("frame must have the columns floquet and floquet_error, with a finite floquet")
+    row = frame.loc[frame.floquet.idxmax()]
+    return floquet_estimate(float(row.floquet), float(row.floquet_error))
 
 
 def multiplier_tolerance(a: float, b: float) -> float:
@@ -270,7 +304,7 @@ def motion_verdict(body: Body, motion, *, limits: Limits | None = None, starts=N
     :data:`ORBIT_SHIFT_TOL` between them the steps are doubled. "periodic" when Newton converges
     on both, the orbit moved by at most :data:`ORBIT_SHIFT_TOL`, |mu_1| from the central
     differences and from the forward and backward ones of step h and h / 2 on the finer map
-    agree within :data:`MULTIPLIER_TOL` and every Floquet multiplier lies inside the unit circle;
+    agree (:func:`multipliers_agree`) and every Floquet multiplier lies inside the unit circle;
     else "undecided" with the reason. Then each of ``starts``
     ((S, 6) states at t = 0, default :data:`lib.optimal.tracker.DEFAULT_STARTS`) runs
     ``periods`` (>= 2) periods on both maps and has reached the orbit

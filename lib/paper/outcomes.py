@@ -28,8 +28,9 @@ class Outcome:
     or a figure whose grid and criterion the paper does not state and that depends on them.
 
     The figure of merit has a kind (:class:`lib.machinery.kinds.Kind`: exact unless the check says
-    it is a certified bound, a motion found or an estimate, which carries ``merit_stderr``), and
-    :meth:`merit_text` writes it as its kind says: a lower bound rounded down, a motion found up."""
+    it is a certified bound, a motion found or an estimate, which carries ``merit_stderr``, its standard
+    or stated error), and :meth:`merit_text` writes it as its kind says: a lower bound rounded down, a
+    motion found up, in the format ``merit_fmt`` (the one its chapter prints it with)."""
     status: str
     merit: float
     merit_label: str
@@ -41,6 +42,7 @@ class Outcome:
     unstated: bool = False
     merit_kind: str = Kind.EXACT.value
     merit_stderr: float | None = None
+    merit_fmt: str = ".3g"
 
     def __post_init__(self) -> None:
         if self.status not in STATUSES:
@@ -49,11 +51,12 @@ class Outcome:
             raise ValueError(f"figure of merit must be finite, got {self.merit!r}")
         self.number()                                  # the kind and its error are consistent
 
-    def number(self, fmt: str = ".3g") -> Number:
-        """The figure of merit as a :class:`~lib.machinery.kinds.Number` of its kind."""
-        return Number(float(self.merit), Kind(self.merit_kind), fmt, stderr=self.merit_stderr)
+    def number(self, fmt: str | None = None) -> Number:
+        """The figure of merit as a :class:`~lib.machinery.kinds.Number` of its kind (format
+        ``fmt``, default ``merit_fmt``)."""
+        return Number(float(self.merit), Kind(self.merit_kind), fmt or self.merit_fmt, stderr=self.merit_stderr)
 
-    def merit_text(self, fmt: str = ".3g") -> str:
+    def merit_text(self, fmt: str | None = None) -> str:
         """The figure of merit as the report writes it (its kind decides the rounding)."""
         return self.number(fmt).text()
 
