@@ -46,8 +46,7 @@ from .motion import periodic_motion
 from .study import PAPER_CAP, setting_label
 from .tracker import (DEFAULT_STARTS, RTOL, PeriodicLQR, _edges, _inside, _inside_bounds, _limits, _loop_inputs, _loop_reference,
                       _piecewise_ivp, _reference, periodic_lqr, track_motion)
-from .verdict import (NEWTON_TOL, ORBIT_SHIFT_TOL, MotionVerdict, _decide, _ladder, _orbit, floquet_text,
-                      motion_verdict)
+from .verdict import NEWTON_TOL, ORBIT_SHIFT_TOL, MotionVerdict, _decide, _ladder, _orbit, floquet_text, motion_verdict
 
 __all__ = ["MARGIN", "MARGIN_SETTINGS", "WRONG_DELTA", "PUSH", "SECOND_EIGHT", "plant_lqr", "pushed_verdict",
            "tracked_case", "margin_cases", "wrong_model_cases", "eight_comparison", "issue_study",
@@ -232,8 +231,7 @@ def tracked_case(model: Body, motion, limits: Limits, *, plant: Body | None = No
     Returns
     -------
     dict
-        regime, reason, floquet (|mu_1|), floquet_error (its stated error,
-        :attr:`lib.optimal.verdict.MotionVerdict.multiplier_error`), starts_reached, starts,
+        regime, reason, floquet (|mu_1|) and floquet_error (its stated error), starts_reached, starts,
         paper_start_reached (on both maps), settled (starts with one fate on both maps), and max_error, rms_error (m),
         F_peak (N), beta_peak (rad), p_range (rad) over one period of the orbit (NaN without one).
     """
@@ -251,8 +249,7 @@ def tracked_case(model: Body, motion, limits: Limits, *, plant: Body | None = No
         v = pushed_verdict(plant, motion, push, limits=limits, lqr=plq)
     meas = _orbit_measures(plant, motion, limits, plq, v.x, push)
     return dict(regime=v.regime, reason=v.reason, floquet=float(np.abs(v.multipliers).max()),
-                floquet_error=float(v.multiplier_error), starts_reached=int(v.reached.sum()),
-                starts=int(v.reached.size),
+                floquet_error=float(v.multiplier_error), starts_reached=int(v.reached.sum()), starts=int(v.reached.size),
                 paper_start_reached=bool(v.reached[0]), settled=int(v.settled.sum()), **meas)
 
 
@@ -426,8 +423,7 @@ _PARAMETER_NAMES = {"m": "$m$", "I": "$I_C$", "c": "$c$", "c_phi": r"$c_\varphi$
 
 
 def _tracked_cells(frame: pd.DataFrame) -> dict:
-    """The tracker's columns as the page writes them: regime, |mu_1| (a numerical estimate with its
-    stated error, :func:`lib.optimal.verdict.floquet_estimate`), starts reached,
+    """The tracker's columns as the page writes them: regime, |mu_1| (verdict.floquet_text), starts reached,
     largest and RMS distance (m, rounded up: values of a motion that exists)."""
     return {"regime": list(frame.regime),
             "largest $|\\mu_1|$": [floquet_text(v, e) for v, e in zip(frame.floquet, frame.floquet_error)],

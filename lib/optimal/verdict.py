@@ -124,10 +124,6 @@ class MotionVerdict:
     settled: np.ndarray | None = None
     multiplier_error: float = math.nan
 
-    def floquet_estimate(self) -> Number:
-        """|mu_1| as the page writes it: a numerical estimate with its stated error (3 decimals)."""
-        return floquet_estimate(float(np.abs(self.multipliers[0])), self.multiplier_error)
-
 
 def floquet_estimate(value: float, error: float) -> Number:
     """A largest |Floquet multiplier| from differences as the book writes it, everywhere: a
