@@ -129,7 +129,7 @@ def _rows():
         base = dict(setting=study.setting_label(a, c), angle_deg=a, cap=c)
         for law, err in (("paper", 0.4), ("weighted", np.inf), ("percussion", 1.1), ("optimal", 0.1)):
             rows.append(dict(base, law=law, regime="periodic", max_error=err, rms_error=err / 2, floquet=0.5,
-                             starts_reached=3, starts=7, paper_start_reached=law == "optimal"))
+                             floquet_error=0.0123, starts_reached=3, starts=7, paper_start_reached=law == "optimal"))
         if c is not None:
             rows.append(dict(base, law="bound", regime="", max_error=0.05, rms_error=0.02))
     return pd.DataFrame(rows)
@@ -163,6 +163,8 @@ def test_the_tracker_table_reads_the_optimal_rows():
     t = compare.tracker_table(_rows())
     assert len(t) == 2 and list(t["starts reached"]) == ["3 of 7", "3 of 7"]
     assert list(t["paper's start"]) == ["yes", "yes"]
+    # a numerical estimate with its stated error (rounded up), as the prose and the report write it
+    assert list(t["largest |multiplier|"]) == ["0.500 ± 0.013"] * 2
     rows = _rows().assign(paper_start_reached=False, paper_start_settled=[True] * 8 + [False])
     t = compare.tracker_table(rows)          # not reached: "no" when both maps agree, else undecided
     assert list(t["paper's start"]) == ["no", "undecided"]

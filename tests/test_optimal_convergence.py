@@ -22,7 +22,7 @@ from lib.optimal import tracker, verdict
 from lib.optimal.motion import periodic_motion
 from lib.optimal.study import CHAPTER_ANGLES_DEG, PAPER_CAP
 from lib.optimal.tracker import REACH_TOL, periodic_lqr, track_motion
-from lib.optimal.verdict import MULTIPLIER_TOL, ORBIT_SHIFT_TOL, motion_verdict
+from lib.optimal.verdict import MULTIPLIER_RTOL, ORBIT_SHIFT_TOL, motion_verdict
 from lib.params import Body
 from test_optimal_tracker import _CircleMotion, _random_collocated_lqr
 
@@ -96,12 +96,12 @@ def test_the_issue_s_coarse_map_is_refined_before_it_decides(body, case):
 
 def test_the_multipliers_agree_across_difference_steps_at_30_deg_and_4_N(body, case):
     """The Jacobian across the clip's kinks: |mu_1| from central differences of step 1e-5 and the
-    one-sided ones of step 1e-5 and 5e-6 agree within MULTIPLIER_TOL, and the orbit attracts."""
+    one-sided ones of step 1e-5 and 5e-6 agree (relatively), and the orbit attracts."""
     motion, lqr, limits = case
     v = motion_verdict(body, motion, limits=limits, lqr=lqr, periods=2, steps=8)
-    # measured spread 9.1e-4 at |mu_1| = 0.030 (DOP853's central differences of step 1e-5 give 0.010,
-    # its variational equation 0.0048: the small multipliers depend on the map, the verdict does not)
-    assert v.multiplier_spread <= MULTIPLIER_TOL
+    # measured spread 9.1e-4 at |mu_1| = 0.030 (3 %, against 25 % allowed); DOP853's central differences
+    # of step 1e-5 give 0.010, its variational equation 0.0048: see tests/test_multiplier_kind.py
+    assert v.multiplier_spread <= MULTIPLIER_RTOL * float(np.abs(v.multipliers[0]))
     assert np.abs(v.multipliers[0]) < 0.1
 
 
@@ -112,7 +112,7 @@ def test_a_kink_through_the_orbit_leaves_the_verdict_undecided(body):
     motion = _CircleMotion(body)
     lqr = periodic_lqr(body, motion)
     v = motion_verdict(body, motion, lqr=lqr, limits=Limits(force=motion.F), periods=2, steps=64, h=1e-3)
-    assert v.regime == "undecided" and "differences" in v.reason and v.multiplier_spread > MULTIPLIER_TOL
+    assert v.regime == "undecided" and "differences" in v.reason and v.multiplier_spread > 0.05
     assert not v.reached.any() and not v.settled.any()
 
 

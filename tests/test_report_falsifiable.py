@@ -341,7 +341,8 @@ def _ch8_study(*, bound=0.1, achieved=0.1002, gap=1e-9, law_max=None, paper_rms=
         rows.append(dict(base, law="paper", regime="periodic", max_error=law_max.get(i, 0.4),
                          rms_error=(paper_rms or {}).get(i, 0.3), floquet=np.nan, paper_start_reached=np.nan))
         rows.append(dict(base, law="optimal", regime=(regimes or {}).get(i, "periodic"), max_error=0.15,
-                         rms_error=(optimal_rms or {}).get(i, 0.05), floquet=0.1, paper_start_reached=True))
+                         rms_error=(optimal_rms or {}).get(i, 0.05), floquet=0.1, floquet_error=0.01,
+                         paper_start_reached=True))
     motions = {k: SimpleNamespace(rms_error=(motion_rms or {}).get(i, 0.05)) for i, k in enumerate(_SETTINGS)}
     b = SimpleNamespace(max_error=bound, max_error_achieved=achieved, gap=gap)
     return dict(table=pd.DataFrame(rows), motions=motions, bound=b)
@@ -409,7 +410,7 @@ def _issue51(*, regimes=None, mu_on=None, cost=None, wrong_regime=None, worst=0.
              trk_regime="periodic", trk_rms=0.3356):
     """Chapter 8's issue-51 study with every clause met, or broken where an argument says so."""
     margin = pd.DataFrame([dict(setting=s, margin=m, regime=(regimes or {}).get((s, m), "periodic"),
-                                floquet=(mu_on or {}).get(s, 0.001) if m else 0.03,
+                                floquet=(mu_on or {}).get(s, 0.001) if m else 0.03, floquet_error=0.001,
                                 rms_error=0.1 + ((cost or {}).get(s, 0.07) if m else 0.0),
                                 starts_reached=3, starts=7, plan_cap=3.6 if m else 4.0)
                            for s in _MARGIN_SETTINGS for m in (False, True)])

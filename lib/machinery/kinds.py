@@ -14,6 +14,9 @@ A number the book prints is one of a few kinds (``Methods``, "A number and its k
   possible (rounded up), never called "the best";
 - **estimate**: a statistic of a run, written with its standard error (``0.30 ± 0.02``), the
   error rounded up;
+- **numerical estimate**: a deterministic computation that no method certifies (a Floquet
+  multiplier from finite differences), written with its stated error (``0.030 ± 0.021``): the
+  spread over the method's own choices (differencing steps, h and h / 2), the error rounded up;
 - **count**: an integer, of a stated total;
 - **setting**: a value the book chooses (a tolerance, a horizon, a step), written exactly as the code
   uses it: after "within" it states the book's own criterion, true by construction.
@@ -34,7 +37,7 @@ from decimal import ROUND_CEILING, ROUND_FLOOR, ROUND_HALF_EVEN, Decimal
 from enum import Enum
 
 __all__ = ["Kind", "Number", "exact", "lower_bound", "upper_bound", "at_most", "at_least", "best_found",
-           "estimate", "count", "setting", "within_accuracy", "round_directed", "MIME", "BOUNDS",
+           "estimate", "numerical", "count", "setting", "within_accuracy", "round_directed", "MIME", "BOUNDS",
            "ROUNDOFF"]
 
 #: the MIME type under which a glued number carries its value and kind beside its text
@@ -51,6 +54,7 @@ class Kind(str, Enum):
     CEILING = "at most"
     FLOOR = "at least"
     ESTIMATE = "estimate"
+    NUMERICAL = "numerical estimate"
     COUNT = "count"
     SETTING = "setting"
 
@@ -70,6 +74,9 @@ BOUNDS = (Kind.LOWER, Kind.UPPER, Kind.FOUND, Kind.CEILING, Kind.FLOOR)
 #: (:func:`within_accuracy` prints the bound its method guarantees instead)
 ROUNDOFF = 1e-9
 
+
+#: the kinds written with an error beside them
+_WITH_ERROR = (Kind.ESTIMATE, Kind.NUMERICAL)
 
 _MODES = {"down": ROUND_FLOOR, "up": ROUND_CEILING, "nearest": ROUND_HALF_EVEN}
 
@@ -133,7 +140,8 @@ class Number:
     fmt : str
         Its format spec ('.4f', '.2e', '.3g'); a count ignores it.
     stderr : float or None
-        An estimate's standard error (same unit), required for an estimate and refused otherwise.
+        An estimate's standard error, or a numerical estimate's stated error (same unit), required
+        for those two kinds and refused otherwise.
     total : int or None
         A count's total, if it has one.
     """
@@ -163,8 +171,9 @@ class Number:
                     Decimal(1e-12) * abs(Decimal(repr(self.value))):
                 raise ValueError(f"fmt: a setting is written exactly, but {self.fmt!r} writes "
                                  f"{self.value!r} as {self.text()!r}")
-        if (kind is Kind.ESTIMATE) != (self.stderr is not None):
-            raise ValueError("stderr: an estimate carries its standard error, and only an estimate does")
+        if (kind in _WITH_ERROR) != (self.stderr is not None):
+            raise ValueError("stderr: an estimate carries its standard error (a numerical estimate its stated "
+                             "error), and only those do")
         if self.stderr is not None and not (math.isfinite(self.stderr) and self.stderr >= 0):
             raise ValueError(f"stderr: a finite non-negative number, got {self.stderr!r}")
 
@@ -173,11 +182,12 @@ class Number:
 
     def text(self) -> str:
         """The number as the page writes it: rounded as its kind says; an estimate as
-        ``value ± stderr`` (the error rounded up, the value to the error's last digit)."""
+        ``value ± stderr`` (the error rounded up, the value to the error's last digit), and so is
+        a numerical estimate with its stated error."""
         if self.kind is Kind.COUNT:
             return str(self.value)
         text = round_directed(self.value, self.fmt, self.kind.rounding)
-        if self.kind is Kind.ESTIMATE:
+        if self.kind in _WITH_ERROR:
             text += " ± " + round_directed(self.stderr, self.fmt, "up")
         return text
 
@@ -378,6 +388,29 @@ def estimate(value: float, stderr: float, fmt: str = ".2f") -> Number:
         The estimate.
     """
     return Number(value, Kind.ESTIMATE, fmt, stderr=float(stderr))
+
+
+def numerical(value: float, error: float, fmt: str = ".3f") -> Number:
+    """A numerical estimate that no method certifies (a Floquet multiplier from finite
+    differences), written ``value ± error``: ``error`` is the stated spread over the method's own
+    choices (differencing steps, the integrator's step), not a standard error of a sampled
+    statistic, and the value is no bound either way.
+
+    Parameters
+    ----------
+    value : float
+        The estimate.
+    error : float
+        Its stated error (>= 0, same unit).
+    fmt : str
+        The format spec of both.
+
+    Returns
+    -------
+    Number
+        The numerical estimate.
+    """
+    return Number(value, Kind.NUMERICAL, fmt, stderr=float(error))
 
 
 def count(n: int, total: int | None = None) -> Number:

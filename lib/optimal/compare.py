@@ -36,7 +36,7 @@ from .bound import cap_bound
 from .loop import FlowMap, halved_verdict, rows_period_end, run_periods, steady_measures
 from .study import PAPER_CAP, SETTINGS, cap_alone_chain, limit_motions, setting_label
 from .tracker import periodic_lqr, track_motion
-from .verdict import basin, motion_verdict
+from .verdict import basin, floquet_text, motion_verdict
 
 __all__ = ["LAWS", "LawLoop", "law_loop", "law_row", "paper_rows", "side_by_side", "WEIGHTS", "THRUST0",
            "LAW_OPTIONS", "LAW_STEPS", "LAW_MAX_STEPS", "PAPER_HORIZON", "PAPER_MEASURED", "RMS_BLOCK",
@@ -257,7 +257,8 @@ def _optimal_row(body: Body, motion, limits: Limits, solved: dict) -> dict:
     meas = steady_measures(res.t, np.c_[res.z, res.dz], res.F, res.beta, res.z_d, F_cap=limits.force,
                            beta_max=limits.angle)
     return dict(regime=v.regime, reason=v.reason, floquet=float(np.abs(v.multipliers).max()),
-                paper_start_reached=bool(v.reached[0]), starts_reached=int(v.reached.sum()),
+                floquet_error=float(v.multiplier_error), paper_start_reached=bool(v.reached[0]),
+                starts_reached=int(v.reached.sum()),
                 starts=int(v.reached.size), paper_start_settled=bool(v.settled[0]),
                 starts_settled=int(v.settled.sum()), verdict_steps=int(v.steps), orbit_shift=float(v.orbit_shift),
                 multiplier_spread=float(v.multiplier_spread), **meas)
@@ -287,7 +288,8 @@ def side_by_side(body: Body, gains: Gains, R: float, Theta: float, motions: dict
     Returns
     -------
     pandas.DataFrame
-        Columns setting, angle_deg, cap, law, regime, reason, floquet, max_error, rms_error (m),
+        Columns setting, angle_deg, cap, law, regime, reason, floquet (floquet_error, its stated error,
+        on the best motion's rows), max_error, rms_error (m),
         F_peak (N), beta_peak (rad), p_range (rad).
     """
     return _side_by_side(body, gains, R, Theta, motions, bounds, settings, kind, {})
@@ -413,9 +415,9 @@ def regime_table(table: pd.DataFrame) -> pd.DataFrame:
 
 def tracker_table(table: pd.DataFrame) -> pd.DataFrame:
     """The best motions' controllers from :func:`side_by_side`'s table: setting, regime, largest
-    |multiplier|, starts reached (on both maps of the verdict, step h and h/2), whether the paper's
-    start is ("undecided" where the two maps disagree), largest and RMS distance (m, rounded up:
-    values of a motion that exists).
+    |multiplier| (a numerical estimate with its stated error), starts reached (on both maps of the
+    verdict, step h and h/2), whether the paper's start is ("undecided" where the two maps
+    disagree), largest and RMS distance (m, rounded up: values of a motion that exists).
 
     Parameters
     ----------
@@ -430,7 +432,7 @@ def tracker_table(table: pd.DataFrame) -> pd.DataFrame:
     opt = table[table.law == "optimal"]
     return pd.DataFrame({
         "setting": opt.setting, "regime": opt.regime,
-        "largest |multiplier|": opt.floquet.map("{:.3f}".format),
+        "largest |multiplier|": [floquet_text(v, e) for v, e in zip(opt.floquet, opt.floquet_error)],
         "starts reached": [f"{int(r)} of {int(n)}" for r, n in zip(opt.starts_reached, opt.starts)],
         "paper's start": ["yes" if r else ("no" if s else "undecided")
                           for r, s in zip(opt.paper_start_reached, opt.get("paper_start_settled",

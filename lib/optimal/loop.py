@@ -36,7 +36,7 @@ from ..machinery import checks
 from ..machinery.cache import source_stamp
 from ..percussion import full_loop
 from ..percussion.full_loop import _rows_field
-from .verdict import MULTIPLIER_TOL, ORBIT_SHIFT_TOL
+from .verdict import ORBIT_SHIFT_TOL, multiplier_tolerance, multipliers_agree
 
 __all__ = ["FlowMap", "LoopVerdict", "loop_verdict", "halved_verdict", "run_periods", "steady_measures",
            "LOOP_OPTIONS", "rows_period_end"]
@@ -382,7 +382,7 @@ def _orbit_shift(flow: FlowMap, a: LoopVerdict, b: LoopVerdict) -> float:
     return float(np.abs(diff).max(axis=1).min())
 
 
-def _disagreement(a: LoopVerdict, b: LoopVerdict, shift: float, change: float, steps: int) -> str:
+def _disagreement(a: LoopVerdict, b: LoopVerdict, shift: float, steps: int) -> str:
     """Why the verdicts a (``steps`` RK4 steps a period) and b (twice as many) do not make one
     verdict, or "" when they do."""
     when = f"when the step was halved from {steps} to {2 * steps} RK4 steps a period"
@@ -392,8 +392,9 @@ def _disagreement(a: LoopVerdict, b: LoopVerdict, shift: float, change: float, s
         return f"the verdict changed {when}: {said[0]}, then {said[1]}"
     if shift > ORBIT_SHIFT_TOL:
         return f"the orbit moved by {shift:.3g} (more than {ORBIT_SHIFT_TOL:g}) {when}"
-    if change > MULTIPLIER_TOL:
-        return f"|mu_1| moved by {change:.3g} (more than {MULTIPLIER_TOL:g}) {when}"
+    if b.regime != "undecided" and not multipliers_agree(a.floquet, b.floquet):
+        return (f"|mu_1| moved from {a.floquet:.3g} to {b.floquet:.3g} (more than "
+                f"{multiplier_tolerance(a.floquet, b.floquet):.3g}) {when}")
     return ""
 
 
@@ -405,7 +406,7 @@ def halved_verdict(rates: Rates, period: float, s0, *, steps: int, max_steps: in
     The two agree when they give the same regime, period and turns and, where they find an
     orbit, the orbit moves by at most :data:`lib.optimal.verdict.ORBIT_SHIFT_TOL` (max-norm,
     state units; to the nearest point of the finer map's cycle, the heading modulo 2 pi) and its
-    largest |Floquet multiplier| by at most :data:`lib.optimal.verdict.MULTIPLIER_TOL`, the
+    largest |Floquet multiplier| agrees (:func:`lib.optimal.verdict.multipliers_agree`, relative), the
     tolerances of the optimal tracker's verdict. For a method of order p the finer map's error is
     about the shift / (2^p - 1): the shift itself where RK4 keeps only p = 1 across the kinks and
     the chattering of a clipped input (Chapter 8's loops: the shift halves with the step), a
@@ -448,7 +449,7 @@ def halved_verdict(rates: Rates, period: float, s0, *, steps: int, max_steps: in
         except SimulationError:
             shift = math.inf
         change = abs(coarse.floquet - fine.floquet) if fine.regime != "undecided" else math.nan
-        reason = _disagreement(coarse, fine, shift, change, steps)
+        reason = _disagreement(coarse, fine, shift, steps)
         if not reason or 4 * steps > max_steps:
             break
         coarse, steps = fine, 2 * steps

@@ -48,7 +48,7 @@ from .loop import steady_measures
 from .motion import periodic_motion
 from .study import PAPER_CAP, setting_label
 from .tracker import DEFAULT_STARTS, RTOL, PeriodicLQR, _edges, _limits, _loop_inputs, _piecewise_ivp, periodic_lqr, track_motion
-from .verdict import _pushed_loop, motion_verdict, pushed_verdict
+from .verdict import _pushed_loop, floquet_text, motion_verdict, pushed_verdict
 
 __all__ = ["MARGIN", "MARGIN_SETTINGS", "WRONG_DELTA", "PUSH", "SECOND_EIGHT", "ENTRY_STEPS", "ENTRY_FIRST",
            "ENTRY_DOUBLINGS", "ENTRY_HALVINGS", "plant_lqr", "tracked_case", "entry_end", "entry_margin",
@@ -148,10 +148,10 @@ def tracked_case(model: Body, motion, limits: Limits, *, plant: Body | None = No
     Returns
     -------
     dict
-        regime, reason, floquet (|mu_1|), starts_reached, starts, paper_start_reached (on both
-        maps), settled (of the seven starts, those with one fate on both maps), and max_error,
-        rms_error (m), F_peak (N), beta_peak (rad), p_range (rad) over one period of the orbit
-        (NaN without one); with ``entry_start``, entry_reached and entry_settled, its fate.
+        regime, reason, floquet (|mu_1|) and floquet_error (its stated error), starts_reached, starts,
+        paper_start_reached (on both maps), settled (of the seven starts, those with one fate on both
+        maps), and max_error, rms_error (m), F_peak (N), beta_peak (rad), p_range (rad) over one period
+        of the orbit (NaN without one); with ``entry_start``, entry_reached and entry_settled, its fate.
     """
     checks.instance("model", model, Body)
     checks.instance("limits", limits, Limits, "lib.allocation.Limits")
@@ -172,6 +172,7 @@ def tracked_case(model: Body, motion, limits: Limits, *, plant: Body | None = No
     meas = _orbit_measures(plant, motion, limits, plq, v.x, push)
     extra = {} if entry_start is None else dict(entry_reached=bool(v.reached[n]), entry_settled=bool(v.settled[n]))
     return dict(regime=v.regime, reason=v.reason, floquet=float(np.abs(v.multipliers).max()),
+                floquet_error=float(v.multiplier_error),
                 starts_reached=int(v.reached[:n].sum()), starts=n, paper_start_reached=bool(v.reached[0]),
                 settled=int(v.settled[:n].sum()), **extra, **meas)
 
@@ -433,10 +434,10 @@ _PARAMETER_NAMES = {"m": "$m$", "I": "$I_C$", "c": "$c$", "c_phi": r"$c_\varphi$
 
 
 def _tracked_cells(frame: pd.DataFrame) -> dict:
-    """The tracker's columns as the page writes them: regime, |mu_1| (rounded up), starts reached,
+    """The tracker's columns as the page writes them: regime, |mu_1| (verdict.floquet_text), starts reached,
     largest and RMS distance (m, rounded up: values of a motion that exists)."""
     return {"regime": list(frame.regime),
-            "largest $|\\mu_1|$": [upper_bound(v, ".3f").text() for v in frame.floquet],
+            "largest $|\\mu_1|$": [floquet_text(v, e) for v, e in zip(frame.floquet, frame.floquet_error)],
             "starts reached": [f"{int(r)} of {int(n)}" for r, n in zip(frame.starts_reached, frame.starts)],
             "largest (m)": [upper_bound(v, ".3f").text() if np.isfinite(v) else "-" for v in frame.max_error],
             "RMS (m)": [upper_bound(v, ".4f").text() if np.isfinite(v) else "-" for v in frame.rms_error]}

@@ -16,8 +16,25 @@ beside those kinks. Three consequences shape this module:
   orbit bends the difference quotient, and one through the orbit point makes the map not
   differentiable there. The Jacobian is taken by central differences of step d, and the verdict
   stands only when the largest multiplier's modulus from the central differences of step d and
-  the forward and backward ones of step d and d / 2 agree within :data:`MULTIPLIER_TOL`
-  (a kink through the point parts forward from backward; one between d / 2 and d, the steps).
+  the forward and backward ones of step d and d / 2 agree (:func:`multipliers_agree`: relative,
+  so that a factor 2 is told apart; a kink through the point parts forward from backward; one
+  between d / 2 and d, the steps).
+- Along a best motion the plan sits *at* the cap (within 1e-7 N) on most pieces, and often at the
+  angle limit: the orbit runs along the kink, not across it. The period map is then piecewise
+  linear about the orbit at every scale above that sliver, and its "multiplier" is that of the
+  side of the kink the orbit happens to sit on: RK4's own O(h^2) error puts its orbit on one
+  side, the same at h and h / 2, and a tight adaptive map or an event-located variational
+  integration on the exact orbit (which never crosses the kink) on others. The largest
+  multiplier is therefore a numerical estimate, not a property certified by any one map: its
+  error (``multiplier_error``) is the largest distance from the value (the finer map's central
+  differences of step d) of |mu_1| from the central and one-sided differences of steps d, d / 2
+  and :data:`KINK_STEP` d (a step that crosses the kinks) on the finer map, the central ones on
+  the coarser, and the central and one-sided ones of steps d and d / 2 on the *resolved* map:
+  the first doubling of the finer map's steps whose orbit error (a third of the shift between
+  the two maps, RK4 keeping second order across kinks, a quarter of it at each doubling) is at
+  most d / :data:`RESOLVE`, so that a step d meets the kinks where the exact loop meets them
+  (within :data:`lib.machinery.domain.MAX_STEPS` a period). At 30 deg + 4 N on the eight the
+  value is 0.030 and the resolved map's quotients fall to 0.007-0.019: the error is 0.023.
 - A start far from the orbit wanders for periods before it meets the basin, and where it meets it
   depends on the step. A start reaches the orbit when it does on both maps; a start whose fate
   differs between them is not settled (``settled`` False).
@@ -37,6 +54,7 @@ from ..dynamics.verdicts import reached
 from ..integrators.batch import RK4, fixed_steps, integrate
 from ..integrators.smooth import Integration, SimulationError
 from ..machinery import checks
+from ..machinery.kinds import Number, numerical
 from ..model import config_accel
 from ..params import Body
 from .riccati import loop_steps
@@ -44,16 +62,27 @@ from .tracker import (DEFAULT_STARTS, NEWTON_ITER, NEWTON_STALL, NEWTON_TOL, REA
                       PeriodicLQR, _check_loop, _edges, _inside, _inside_bounds, _limits, _loop, _loop_inputs,
                       _loop_reference, _piecewise_ivp, _reference, periodic_lqr)
 
-__all__ = ["MotionVerdict", "motion_verdict", "pushed_verdict", "basin", "offset_starts", "ORBIT_SHIFT_TOL",
-           "MULTIPLIER_TOL", "FINE_RTOL"]
+__all__ = ["MotionVerdict", "motion_verdict", "pushed_verdict", "basin", "offset_starts", "multipliers_agree",
+           "multiplier_tolerance", "floquet_estimate", "floquet_text", "largest_floquet", "ORBIT_SHIFT_TOL",
+           "MULTIPLIER_TOL", "MULTIPLIER_RTOL", "MULTIPLIER_ATOL", "KINK_STEP", "RESOLVE", "FINE_RTOL"]
 
 #: the most the orbit may move (max-norm, state units) when the step is halved, a tenth of the
 #: reach tolerance :data:`lib.optimal.tracker.REACH_TOL`, so that a start's distance to it is
 #: decided by the dynamics, not by the step
 ORBIT_SHIFT_TOL = 0.1 * REACH_TOL
-#: the most |mu_1| may change between central differences of step d and d / 2, as the verdict reads
-#: |mu_1| < 1, and the reach test |mu_1| ** (periods / 2) against a factor 3
-MULTIPLIER_TOL = 0.05
+#: the most two values of |mu_1| may differ and agree (:func:`multiplier_tolerance`): MULTIPLIER_RTOL of
+#: the larger (a factor 2 differs by half the larger: told apart), never more than MULTIPLIER_TOL (as the
+#: verdict reads |mu_1| < 1, and the reach test |mu_1| ** (periods / 2) against a factor 3), and never
+#: less than MULTIPLIER_ATOL: at |mu_1| <= 0.005 the reach test's term 3 d |mu_1| ** 4 (over the chapter's
+#: 8 periods) is below 2e-9 d, three orders under its floor for any start within a metre, so two
+#: multipliers that small are alike to both readings (a factor 2 above it is told apart)
+MULTIPLIER_TOL, MULTIPLIER_RTOL, MULTIPLIER_ATOL = 0.05, 0.25, 5e-3
+#: the differencing step, in units of the verdict's step h, that crosses the clip's kinks beside the orbit
+#: (the RK4 orbit sits off them by its O(h^2) error, about 1e-5 state units): its one-sided
+#: quotients are those of the kink's other side, and enter the multiplier's stated error
+KINK_STEP = 10.0
+#: the resolved map's orbit error is at most the differencing step / RESOLVE
+RESOLVE = 10.0
 #: the adaptive map's second tolerance (``steps`` = 0): DOP853 at rtol = atol = RTOL / 100
 FINE_RTOL = RTOL / 100
 #: a state beyond this magnitude (m, rad, m/s, rad/s) has blown up
@@ -72,7 +101,8 @@ class MotionVerdict:
     RK4 steps on each input piece for the coarser map, twice as many for the finer (0: DOP853 at
     :data:`lib.optimal.tracker.RTOL` and :data:`FINE_RTOL`); ``orbit_shift`` how far the orbit
     moved between the two (max-norm, state units), ``multiplier_spread`` the range of |mu_1| over
-    the central and one-sided difference Jacobians of step h and h / 2. Per start (S,):
+    the central and one-sided difference Jacobians of step h and h / 2, ``multiplier_error`` the
+    stated error of |mu_1| (the module's docstring; :func:`floquet_estimate`). Per start (S,):
     ``reached`` (on both maps), ``settled``
     (the same fate on both) and ``distance``, the finer map's final section distance to the orbit
     point (max-norm, heading unwrapped; NaN when the starts were not run), after ``periods``
@@ -93,6 +123,81 @@ class MotionVerdict:
     orbit_shift: float = math.nan
     multiplier_spread: float = math.nan
     settled: np.ndarray | None = None
+    multiplier_error: float = math.nan
+
+
+def floquet_estimate(value: float, error: float) -> Number:
+    """A largest |Floquet multiplier| from differences as the book writes it, everywhere: a
+    numerical estimate ``value ± error`` (:func:`lib.machinery.kinds.numerical`) to the decimal
+    of the error's second significant digit, at least 3 decimals and at most the value's third
+    significant digit: ``0.030 ± 0.023``, ``0.0028 ± 0.0013``, ``0.000934 ± 0.000001``.
+
+    Parameters
+    ----------
+    value, error : float
+        |mu_1| and its stated error (:class:`MotionVerdict`), finite, >= 0.
+
+    Returns
+    -------
+    Number
+    """
+    value, error = checks.number("value", value, nonnegative=True), checks.number("error", error, nonnegative=True)
+
+    def decimals(x, digits):
+        return digits - 1 - math.floor(math.log10(x)) if x > 0 else 3
+    return numerical(value, error, f".{max(3, min(decimals(error, 2), decimals(value, 3)))}f")
+
+
+def floquet_text(value: float, error: float) -> str:
+    """:func:`floquet_estimate`'s text, or "-" where the row has no multiplier or no error (no orbit)."""
+    ok = math.isfinite(value) and math.isfinite(error)
+    return floquet_estimate(value, error).text() if ok else "-"
+
+
+def largest_floquet(frame: pd.DataFrame) -> Number:
+    """The largest |mu_1| of a table's rows (columns ``floquet`` and ``floquet_error``, as
+    :func:`lib.optimal.compare.side_by_side` and :func:`lib.optimal.margins.tracked_case` give
+    them) with that row's error, as :func:`floquet_estimate` writes it: the page's prose, its
+    tables and the report print the same text.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        Rows with finite ``floquet``.
+
+    Returns
+    -------
+    Number
+    """
+    checks.instance("frame", frame, pd.DataFrame)
+    if not {"floquet", "floquet_error"} <= set(frame.columns) or not np.isfinite(frame.floquet).any():
+        raise ValueError("frame must have the columns floquet and floquet_error, with a finite floquet")
+    row = frame.loc[frame.floquet.idxmax()]
+    return floquet_estimate(float(row.floquet), float(row.floquet_error))
+
+
+def multiplier_tolerance(a: float, b: float) -> float:
+    """How far two values of |mu_1| may lie apart and agree: :data:`MULTIPLIER_RTOL` of the larger
+    modulus, at most :data:`MULTIPLIER_TOL` and at least :data:`MULTIPLIER_ATOL`."""
+    big = max(abs(a), abs(b))
+    return max(MULTIPLIER_ATOL, min(MULTIPLIER_TOL, MULTIPLIER_RTOL * big))
+
+
+def multipliers_agree(a: float, b: float) -> bool:
+    """Whether two values of |mu_1| agree, relatively (:func:`multiplier_tolerance`): 0.008 and
+    0.03 do not, nor does any pair a factor 2 apart above :data:`MULTIPLIER_ATOL`; NaN never does.
+
+    Parameters
+    ----------
+    a, b : float
+        The two moduli (dimensionless).
+
+    Returns
+    -------
+    bool
+    """
+    a, b = float(a), float(b)
+    return bool(math.isfinite(a) and math.isfinite(b) and abs(a - b) <= multiplier_tolerance(a, b))
 
 
 def _period_map(lqr: PeriodicLQR, F_max, beta_max, steps: int = 0, rtol: float = RTOL):
@@ -143,6 +248,14 @@ def _difference_step(advance, d: float):
     return step
 
 
+def _quotients(advance, x, d: float) -> list:
+    """The central, forward and backward difference Jacobians of step d of the map at x (6,)."""
+    E = d * np.eye(6)
+    Y = advance(np.concatenate([x[None], x + E, x - E]))
+    fw, bw = (Y[1:7] - Y[0]).T / d, (Y[0] - Y[7:]).T / d
+    return [(fw + bw) / 2, fw, bw]
+
+
 def _one_sided(advance, x, d: float) -> list:
     """The four one-sided difference Jacobians of the map at x (6,): forward and backward, of step
     d and d / 2. Where the map is differentiable near x they agree with the central ones to
@@ -190,7 +303,7 @@ def motion_verdict(body: Body, motion, *, limits: Limits | None = None, starts=N
     :data:`ORBIT_SHIFT_TOL` between them the steps are doubled. "periodic" when Newton converges
     on both, the orbit moved by at most :data:`ORBIT_SHIFT_TOL`, |mu_1| from the central
     differences and from the forward and backward ones of step h and h / 2 on the finer map
-    agree within :data:`MULTIPLIER_TOL` and every Floquet multiplier lies inside the unit circle;
+    agree (:func:`multipliers_agree`) and every Floquet multiplier lies inside the unit circle;
     else "undecided" with the reason. Then each of ``starts``
     ((S, 6) states at t = 0, default :data:`lib.optimal.tracker.DEFAULT_STARTS`) runs
     ``periods`` (>= 2) periods on both maps and has reached the orbit
@@ -238,27 +351,53 @@ def motion_verdict(body: Body, motion, *, limits: Limits | None = None, starts=N
         if not (shift > ORBIT_SHIFT_TOL) or j == len(ladder) - 1:
             break
         coarse, orb_c = fine, orb_f
-    return _decide(orb_c, orb_f, coarse, fine, x_star, starts, periods, h, ladder[j - 1][0], shift)
+    return _decide(orb_c, orb_f, coarse, fine, x_star, starts, periods, h, ladder[j - 1][0], shift,
+                   refine=lambda s: _period_map(lqr, F_max, beta_max, s) if s * pieces <= checks.MAX_STEPS else None)
 
 
-def _decide(orb_c, orb_f, coarse, fine, x_star, starts, periods, h, steps, shift) -> MotionVerdict:
-    """The verdict from Newton's results on the two maps, and the runs from the starts when periodic."""
+def _resolved_radii(refine, steps: int, shift: float, x, h: float) -> list:
+    """|mu_1| from the central and one-sided differences of steps h and h / 2 on the resolved map
+    (the module's docstring): ``refine(s)`` the map of s RK4 steps a piece, or None beyond the
+    budget; ``steps`` the finer map's, ``shift`` the orbit's between it and the coarser. Empty
+    when the finer map is resolved already, or when Newton does not converge on the resolved map."""
+    s, err = steps, shift / 3.0
+    while err > h / RESOLVE and refine(2 * s) is not None:
+        s, err = 2 * s, err / 4.0
+    if s == steps:
+        return []
+    resolved = refine(s)
+    orb = _orbit(resolved, x, h)
+    if not orb.residual[0] <= NEWTON_TOL:
+        return []
+    Js = [orb.jacobian[0]] + _one_sided(resolved, orb.x[0], h)
+    return [_radius(floquet_multipliers(J)) if np.all(np.isfinite(J)) else math.inf for J in Js]
+
+
+def _decide(orb_c, orb_f, coarse, fine, x_star, starts, periods, h, steps, shift, refine=None) -> MotionVerdict:
+    """The verdict from Newton's results on the two maps, and the runs from the starts when periodic;
+    ``refine(s)`` the map of s RK4 steps a piece (None beyond the budget), for the multiplier's error."""
     ok = bool(orb_c.residual[0] <= NEWTON_TOL and orb_f.residual[0] <= NEWTON_TOL)
     x, J = orb_f.x[0], orb_f.jacobian[0]
     mult = floquet_multipliers(J) if np.all(np.isfinite(J)) else np.full(6, np.nan + 0j)
-    rho, spread = _radius(mult), math.nan
+    rho, spread, error, agree = _radius(mult), math.nan, math.nan, False
     if ok:
-        radii = [_radius(floquet_multipliers(Jd)) if np.all(np.isfinite(Jd)) else math.inf
-                 for Jd in _one_sided(fine, x, h)]
-        spread = max(radii) - min(radii + [rho])
+        def radii(Js):
+            return [_radius(floquet_multipliers(Jd)) if np.all(np.isfinite(Jd)) else math.inf for Jd in Js]
+        near = radii(_one_sided(fine, x, h)) + [rho]
+        spread, agree = max(near) - min(near), multipliers_agree(max(near), min(near))
+        wide = near + radii(_quotients(fine, x, KINK_STEP * h)) + radii([orb_c.jacobian[0]])
+        if refine is not None and steps:
+            wide += _resolved_radii(refine, 2 * steps, shift, x, h)
+        error = max(abs(r - rho) for r in wide)
     what = f"{2 * steps} RK4 steps a piece" if steps else f"rtol {FINE_RTOL:g}"
-    reason = ("" if ok and shift <= ORBIT_SHIFT_TOL and spread <= MULTIPLIER_TOL and rho < 1.0
+    reason = ("" if ok and shift <= ORBIT_SHIFT_TOL and agree and rho < 1.0
               else f"Newton did not converge (residual {max(orb_c.residual[0], orb_f.residual[0]):.3g})" if not ok
               else f"the orbit moved by {shift:.3g} (more than {ORBIT_SHIFT_TOL:g}) at {what}"
               if not shift <= ORBIT_SHIFT_TOL
               else f"|mu_1| from central and one-sided differences of step {h:g} and {h / 2:g} differ by "
-                   f"{spread:.3g} (more than {MULTIPLIER_TOL:g}): the map is not differentiable there"
-              if not spread <= MULTIPLIER_TOL
+                   f"{spread:.3g} (more than {MULTIPLIER_RTOL:g} of the larger, at most {MULTIPLIER_TOL:g}): the "
+                   "map is not differentiable there"
+              if not agree
               else f"the orbit does not attract (|mu_1| = {rho:.6g})")
     S = len(starts)
     hit, settled, dist = np.zeros(S, bool), np.zeros(S, bool), np.full(S, np.nan)
@@ -271,7 +410,7 @@ def _decide(orb_c, orb_f, coarse, fine, x_star, starts, periods, h, steps, shift
                          residual=float(orb_f.residual[0]), multipliers=mult, offset=off,
                          position_offset=float(np.hypot(off[0], off[1])), heading_offset=float(off[2]),
                          reached=hit, distance=dist, periods=periods, steps=steps, orbit_shift=shift,
-                         multiplier_spread=spread, settled=settled)
+                         multiplier_spread=spread, settled=settled, multiplier_error=error)
 
 
 def _reach(advance, x, starts, periods: int, rho: float):
@@ -434,7 +573,8 @@ def pushed_verdict(body: Body, motion, push, *, limits: Limits | None = None, lq
     starts = checks.array("starts", DEFAULT_STARTS if starts is None else starts, shape=(None, 6), nonempty=True)
     F_max, beta_max = _limits(limits, motion)
     x_star = _reference(motion, 0.0)[0]
-    ladder = _ladder(steps, len(_edges(motion, 0.0, motion.period)) - 1)
+    pieces = len(_edges(motion, 0.0, motion.period)) - 1
+    ladder = _ladder(steps, pieces)
     coarse = _pushed_map(lqr, F_max, beta_max, ladder[0][0], push)
     orb_c = _orbit(coarse, x_star, h)
     for j in range(1, len(ladder)):
@@ -444,4 +584,6 @@ def pushed_verdict(body: Body, motion, push, *, limits: Limits | None = None, lq
         if not (shift > ORBIT_SHIFT_TOL) or j == len(ladder) - 1:
             break
         coarse, orb_c = fine, orb_f
-    return _decide(orb_c, orb_f, coarse, fine, x_star, starts, periods, h, ladder[j - 1][0], shift)
+    return _decide(orb_c, orb_f, coarse, fine, x_star, starts, periods, h, ladder[j - 1][0], shift,
+                   refine=lambda s: (_pushed_map(lqr, F_max, beta_max, s, push) if s * pieces <= checks.MAX_STEPS
+                                     else None))

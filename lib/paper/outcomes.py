@@ -28,10 +28,11 @@ class Outcome:
     or a figure whose grid and criterion the paper does not state and that depends on them.
 
     The figure of merit has a kind (:class:`lib.machinery.kinds.Kind`: exact unless the check says
-    it is a certified bound, a motion found or an estimate, which carries ``merit_stderr``), and
-    :meth:`merit_text` writes it as its kind says: a lower bound rounded down, a motion found up,
-    to the digits ``merit_fmt`` gives (a coefficient the paper prints to two decimals is shown
-    to four, so that the digit it gets wrong is visible)."""
+    it is a certified bound, a motion found or an estimate, which carries ``merit_stderr``, its standard
+    or stated error), and :meth:`merit_text` writes it as its kind says: a lower bound rounded down, a
+    motion found up, to the digits ``merit_fmt`` gives (a coefficient the paper prints to two decimals
+    is shown to four, so that the digit it gets wrong is visible; a multiplier in the format its
+    chapter prints it with)."""
     status: str
     merit: float
     merit_label: str
@@ -53,8 +54,8 @@ class Outcome:
         self.number()                                  # the kind and its error are consistent
 
     def number(self, fmt: str | None = None) -> Number:
-        """The figure of merit as a :class:`~lib.machinery.kinds.Number` of its kind, to ``fmt``
-        (default ``merit_fmt``)."""
+        """The figure of merit as a :class:`~lib.machinery.kinds.Number` of its kind (format
+        ``fmt``, default ``merit_fmt``)."""
         return Number(float(self.merit), Kind(self.merit_kind), fmt or self.merit_fmt, stderr=self.merit_stderr)
 
     def merit_text(self, fmt: str | None = None) -> str:
