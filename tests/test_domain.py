@@ -19,7 +19,8 @@ from lib.rotation import attractor, reduced
 from lib.simulate import simulate
 from lib.tracking import mismatch, runs as tracking
 from lib.weighting import batch as weighting_batch, comparison, verdicts as loop_verdicts
-from lib.optimal import bound as optimal_bound, motion as optimal_motion, study as optimal_study
+from lib.optimal import bound as optimal_bound, motion as optimal_motion
+from lib.optimal.studies import study as optimal_study
 from lib.percussion import compare as percussion_compare, zero_dynamics
 from lib.percussion.run import simulate as p_simulate
 from lib.rotation import circle_global, slow_eight

@@ -1,7 +1,7 @@
 """A Floquet multiplier from differences is a numerical estimate with a stated error, never a bound.
 
 The kind (lib.machinery.kinds.numerical), the verdict's relative agreement of multipliers
-(lib.optimal.verdict.multipliers_agree), and the largest multiplier at 30 deg + 4 N on Chapter 8's
+(lib.optimal.floquet.multipliers_agree), and the largest multiplier at 30 deg + 4 N on Chapter 8's
 eight against an independent route: the loop's directional (Bouligand) derivative along the
 planned motion, whose force sits at its cap and heading at its angle limit on most input pieces,
 integrated by DOP853 with the clip's one-sided derivative on those pieces, and iterated until the
@@ -22,9 +22,10 @@ from lib.machinery.kinds import Kind, Number
 from lib.optimal import tracker
 from lib.optimal.loop import LoopVerdict, _disagreement
 from lib.optimal.motion import periodic_motion
-from lib.optimal.study import CHAPTER_ANGLES_DEG, PAPER_CAP
-from lib.optimal.verdict import (MULTIPLIER_ATOL, MULTIPLIER_TOL, floquet_estimate, floquet_text, motion_verdict,
+from lib.optimal.studies.study import CHAPTER_ANGLES_DEG, PAPER_CAP
+from lib.optimal.floquet import (MULTIPLIER_ATOL, MULTIPLIER_TOL, floquet_estimate, floquet_text,
                                  multiplier_tolerance, multipliers_agree)
+from lib.optimal.verdict import motion_verdict
 from lib.params import Body
 
 R_EIGHT, THETA_EIGHT = 2.0, math.pi / 4       # Chapter 8's eight (lib.paper.studies.R0, THETA0)

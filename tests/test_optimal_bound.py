@@ -12,7 +12,8 @@ from scipy.optimize import minimize_scalar
 
 from lib import model, trajectories as tr
 from lib.optimal import bound as B
-from lib.optimal.motion import held_force_motion
+from lib.optimal import held as H
+from lib.optimal.held import held_force_motion
 from lib.params import Body
 
 BODY = Body()
@@ -368,7 +369,7 @@ def test_the_held_force_motion_is_a_periodic_motion_of_the_full_model(bound80, o
     # reason: the bound scales its held force onto the cap where the solver left it a hair above
     assert F.max() <= 4.0 * (1 + 1e-12) and np.abs(beta).max() <= math.pi
     # a located orbit: Newton's residual, and it attracts (both multipliers inside the unit circle)
-    assert m.residual <= B.HEADING_TOL and np.abs(m.multipliers).max() < 1.0
+    assert m.residual <= H.HEADING_TOL and np.abs(m.multipliers).max() < 1.0
 
     def rhs(t, x, k):
         F, beta = m.inputs(np.clip(t, m.t[k] + 1e-9, m.t[k] + m.period / m.t.size - 1e-9))
@@ -389,4 +390,4 @@ def test_the_held_force_motion_is_a_periodic_motion_of_the_full_model(bound80, o
 def test_heading_orbit_bad_arguments_raise_naming_them(bound80, kw, exc, name):
     args = dict(body=BODY, bound=bound80) | kw
     with pytest.raises(exc, match=f"^{name}"):
-        B.heading_orbit(args.pop("body"), args.pop("bound"), **args)
+        H.heading_orbit(args.pop("body"), args.pop("bound"), **args)

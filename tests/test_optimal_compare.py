@@ -1,4 +1,4 @@
-"""lib.optimal.compare and the study's tables: the paper's law measured as Chapter 4 measures it,
+"""lib.optimal.studies.compare and the study's tables: the paper's law measured as Chapter 4 measures it,
 and the page's tables from a table of rows."""
 
 import math
@@ -11,10 +11,10 @@ from lib import trajectories
 from lib.allocation import Limits
 from lib.integrators.smooth import SimulationError
 from lib.limits.runs import switched_runs
-from lib.optimal import compare, study
+from lib.optimal.studies import compare, study
 from lib.optimal.bound import cap_bound
 from lib.optimal.loop import BLOWUP, FlowMap
-from lib.optimal.motion import held_force_motion
+from lib.optimal.held import held_force_motion
 from lib.optimal.tracker import periodic_lqr, track_motion
 from lib.optimal.verdict import ORBIT_SHIFT_TOL
 from lib.params import PAPER_DZ0, PAPER_Z0, Body, Gains
@@ -180,7 +180,7 @@ def test_setting_labels():
 @pytest.mark.parametrize("objective", ["max", "rms"])
 def test_the_tracker_at_the_cap_holds_the_convex_optimum_within_a_millimetre_of_its_bracket(objective):
     """The periodic LQR about the convex problem's achieved motion (a held world force, the heading
-    on its orbit: lib.optimal.motion.held_force_motion), started 5 cm and 0.3 rad off it under the
+    on its orbit: lib.optimal.held.held_force_motion), started 5 cm and 0.3 rad off it under the
     4 N cap, leaves over its third period a largest (or RMS) distance within 1e-3 m of the bound's
     bracket at 128 nodes: a controller at the physical limit."""
     b = cap_bound(BODY, 2.0, math.pi / 4, 4.0, nodes=128)

@@ -20,9 +20,10 @@ from lib.allocation import Limits
 from lib.integrators.batch import RK4, integrate
 from lib.optimal import tracker, verdict
 from lib.optimal.motion import periodic_motion
-from lib.optimal.study import CHAPTER_ANGLES_DEG, PAPER_CAP
+from lib.optimal.studies.study import CHAPTER_ANGLES_DEG, PAPER_CAP
 from lib.optimal.tracker import REACH_TOL, periodic_lqr, track_motion
-from lib.optimal.verdict import MULTIPLIER_RTOL, ORBIT_SHIFT_TOL, motion_verdict
+from lib.optimal.floquet import MULTIPLIER_RTOL
+from lib.optimal.verdict import ORBIT_SHIFT_TOL, motion_verdict
 from lib.params import Body
 from test_optimal_tracker import _CircleMotion, _random_collocated_lqr
 

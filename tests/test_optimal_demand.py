@@ -1,4 +1,4 @@
-"""The price of exactness: the peak force that exact tracking needs (lib.optimal.demand)."""
+"""The price of exactness: the peak force that exact tracking needs (lib.optimal.studies.demand)."""
 
 import math
 
@@ -8,7 +8,7 @@ import pytest
 from scipy.optimize import minimize_scalar
 
 from lib import percussion as pc, trajectories as tr
-from lib.optimal import demand as dm
+from lib.optimal.studies import demand as dm
 from lib.params import Body
 from lib.percussion.engine import HeadingEngine
 from lib.rotation.verdicts import FIG5_GRID

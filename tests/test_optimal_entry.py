@@ -1,5 +1,5 @@
-"""The entry manoeuvre from the paper's start onto a best motion found (lib.optimal.collocation
-.entry_motion), and the periodic LQR's verdict from where it ends (lib.optimal.study.entry_rows)."""
+"""The entry manoeuvre from the paper's start onto a best motion found (lib.optimal.entry
+.entry_motion), and the periodic LQR's verdict from where it ends (lib.optimal.studies.entries.entry_rows)."""
 
 from __future__ import annotations
 
@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 
 from lib.optimal import motion as mo
-from lib.optimal import study
-from lib.optimal.collocation import ENTRY_PERIODS, entry_motion
+from lib.optimal.studies import entries
+from lib.optimal.studies import study
+from lib.optimal.entry import ENTRY_PERIODS, entry_motion
 from lib.params import PAPER_DZ0, PAPER_Z0, Body
 
 BODY, R, THETA, DEG = Body(), 2.0, math.pi / 4, math.pi / 180
@@ -44,7 +45,7 @@ def test_the_entry_keeps_to_the_limits_and_its_integrated_inputs_end_on_the_moti
 
 
 def test_the_paper_start_reaches_the_orbit_after_the_entry(capped30):
-    rows = study.entry_rows(BODY, {(30, 4.0): capped30})
+    rows = entries.entry_rows(BODY, {(30, 4.0): capped30})
     r = rows.iloc[0]
     assert r.setting == study.setting_label(30, 4.0) and r.regime == "periodic"
     assert r.reached and r.settled
@@ -89,7 +90,7 @@ def test_the_entry_table_rounds_its_distances_up_and_says_where_the_maps_disagre
                               end_position=5e-8),
                          dict(setting="90 deg", reached=False, settled=True, entry_rms=0.1, entry_max=0.9,
                               end_position=1e-6)])
-    t = study.entry_table(rows)
+    t = entries.entry_table(rows)
     assert list(t["paper's start reaches"]) == ["yes", "undecided", "no"]
     assert list(t["entry RMS (m)"]) == ["0.120", "0.190", "0.100"] and t["entry largest (m)"][0] == "0.983"
     assert t["end gap (m)"][0] == "3e-06"
@@ -109,16 +110,16 @@ def test_the_entry_figure_draws_the_path_the_entry_and_the_motion(capped30, entr
 
 def test_entry_rows_refuse_what_is_not_a_dict_of_motions():
     with pytest.raises(TypeError, match="motions"):
-        study.entry_rows(BODY, [1, 2])
+        entries.entry_rows(BODY, [1, 2])
     with pytest.raises(TypeError, match="motions"):
-        study.entry_rows(BODY, {(30, 4.0): "a motion"})
+        entries.entry_rows(BODY, {(30, 4.0): "a motion"})
 
 
 def test_the_basin_with_the_entry_reaches_the_orbit_from_moved_starts(capped30):
     from lib.allocation import Limits
-    fr = study.entry_basin(BODY, capped30, Limits(4.0, 30 * DEG), heading_offsets=[0.0, math.pi / 2],
+    fr = entries.entry_basin(BODY, capped30, Limits(4.0, 30 * DEG), heading_offsets=[0.0, math.pi / 2],
                            position_offsets=[0.5])
     assert list(fr.columns) == ["heading_offset", "x_offset", "entry", "reached", "settled"]
     assert fr.entry.all() and fr.reached.all() and fr.settled.all()
     with pytest.raises(TypeError, match="limits"):
-        study.entry_basin(BODY, capped30, None)
+        entries.entry_basin(BODY, capped30, None)

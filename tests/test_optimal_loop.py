@@ -12,7 +12,8 @@ from lib.closed_loop import ClosedLoop, reference_of
 from lib.machinery import checks
 from lib.optimal.loop import (LOOP_OPTIONS, FlowMap, LoopVerdict, _orbit_shift, halved_verdict, loop_verdict,
                               run_periods, steady_measures)
-from lib.optimal.verdict import MULTIPLIER_TOL, ORBIT_SHIFT_TOL
+from lib.optimal.floquet import MULTIPLIER_TOL
+from lib.optimal.verdict import ORBIT_SHIFT_TOL
 from lib.params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from lib.rotation.circle import circle_eigenvalues, circle_equilibria
 

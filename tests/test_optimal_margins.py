@@ -1,6 +1,6 @@
 """Chapter 8's tracker on a wrong plant, under a push, with a margin, and on a second eight, and
-the entry run open loop on a wrong plant or from a disturbed start (:mod:`lib.optimal.margins`;
-the pushed verdict, :func:`lib.optimal.verdict.pushed_verdict`).
+the entry run open loop on a wrong plant or from a disturbed start (:mod:`lib.optimal.studies.margins`;
+the pushed verdict, :func:`lib.optimal.pushed.pushed_verdict`).
 
 The wrong plant reuses the tracker's loops by moving the plant's input matrix into the Riccati
 solution (:func:`plant_lqr`): the tests prove, through the numpy and the compiled loop, that the
@@ -20,12 +20,14 @@ import pytest
 from lib.allocation import Limits
 from lib.model import config_accel
 from lib.model import config_from_state, state_from_config
-from lib.optimal import margins as mg
-from lib.optimal.collocation import entry_motion
+from lib.optimal.studies import entries
+from lib.optimal.studies import margins as mg
+from lib.optimal.entry import entry_motion
 from lib.optimal.motion import periodic_motion
 from lib.optimal.riccati import loop_rhs
 from lib.optimal.tracker import _loop, _loop_inputs, _reference, periodic_lqr
-from lib.optimal.verdict import _pushed_loop, motion_verdict, pushed_verdict
+from lib.optimal.pushed import _pushed_loop, pushed_verdict
+from lib.optimal.verdict import motion_verdict
 from lib.params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from lib.simulate import simulate_open_loop
 from lib.tracking.mismatch import model_of
@@ -160,9 +162,9 @@ def test_edges_refused_naming_the_argument(lqr, motion, entry):
     with pytest.raises(ValueError, match="first"):
         mg.entry_margin(BODY, motion, Limits(4.0, None), first={"m": -0.1})
     with pytest.raises(ValueError, match="start"):
-        mg.entry_end(BODY, motion, entry, np.zeros(5))
+        entries.entry_end(BODY, motion, entry, np.zeros(5))
     with pytest.raises(TypeError, match="entry"):
-        mg.entry_end(BODY, motion, "plan")
+        entries.entry_end(BODY, motion, "plan")
 
 
 @pytest.fixture(scope="module")
@@ -193,16 +195,16 @@ def test_the_entry_run_open_loop_ends_where_an_independent_integration_does(moti
     paper = np.concatenate([PAPER_Z0, PAPER_DZ0])
     # accuracy: RK4 at 4 steps a piece of 0.1 s against DOP853 at 1e-10; measured 1.1e-6, falling 14
     # times a halving (fourth order): 1e-5 bounds it with the order's room
-    np.testing.assert_allclose(mg.entry_end(BODY, motion, entry), entry.end, rtol=0, atol=1e-5)
+    np.testing.assert_allclose(entries.entry_end(BODY, motion, entry), entry.end, rtol=0, atol=1e-5)
     plant = model_of(BODY, m=0.1, a=-0.1)
-    np.testing.assert_allclose(mg.entry_end(plant, motion, entry), _entry_end_by_solve_ivp(plant, motion, entry, paper),
+    np.testing.assert_allclose(entries.entry_end(plant, motion, entry), _entry_end_by_solve_ivp(plant, motion, entry, paper),
                                rtol=0, atol=1e-5)     # accuracy: as above
     # rows at once: each row its own run (exact up to the RK4 sums' rounding)
     starts = paper + np.array([[0, 0, 0, 0, 0, 0], [0.1, 0, 0.2, 0, 0, 0]])
-    both = mg.entry_end(BODY, motion, entry, starts)
-    np.testing.assert_allclose(both[1], mg.entry_end(BODY, motion, entry, starts[1]), rtol=0, atol=1e-12)
+    both = entries.entry_end(BODY, motion, entry, starts)
+    np.testing.assert_allclose(both[1], entries.entry_end(BODY, motion, entry, starts[1]), rtol=0, atol=1e-12)
     # a push along x moves the end along x by about F t^2 / (2 m) without drag: clearly
-    assert mg.entry_end(BODY, motion, entry, push=(0.2, 0.0))[0] - both[0, 0] > 0.1
+    assert entries.entry_end(BODY, motion, entry, push=(0.2, 0.0))[0] - both[0, 0] > 0.1
 
 
 def test_the_entry_reach_on_each_wrong_plant_is_the_verdicts_on_that_plant_alone(motion, lqr):

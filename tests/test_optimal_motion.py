@@ -10,7 +10,7 @@ import pytest
 from lib import model
 from lib.optimal import collocation as col
 from lib.optimal import motion as mo
-from lib.optimal import study
+from lib.optimal.studies import study
 from lib.machinery.kinds import best_found
 from lib.optimal.bound import cap_bound
 from lib.params import Body

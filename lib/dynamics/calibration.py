@@ -15,7 +15,7 @@ settings of :data:`LIMIT_DEG` and :data:`FIG5_POINTS`:
   far apart they end up); the exponent over :data:`LIMIT_PERIODS` periods (blocks of 12, as
   :func:`lib.limits.verdicts.limit_verdicts`), the heading's drift over the same periods (block
   ends every 12) and C's RMS distance from the path over the last :data:`RMS_PERIODS` of them
-  (per-period mean squares, shortest block 2, as :func:`lib.optimal.compare.paper_rows`);
+  (per-period mean squares, shortest block 2, as :func:`lib.optimal.studies.compare.paper_rows`);
 - the reduced rotation (32) at chaotic points of Fig. 5 (Chapter 5): distinct random starts
   p(0), dp/dt(0), each decided by :func:`lib.rotation.verdicts.rotation_verdicts` itself,
   whose exponent and drift the map reports; a start that lands on another attractor (another
@@ -68,7 +68,7 @@ VARIOGRAM_LAGS = (1, 12, 48, 72, 144)
 
 #: blocks (periods) of the limit verdicts' exponent and drift
 _LIMIT_BLOCK = 12
-#: the shortest block (periods) Chapter 8 asks for the RMS distance's error (lib.optimal.compare.RMS_BLOCK)
+#: the shortest block (periods) Chapter 8 asks for the RMS distance's error (lib.optimal.studies.compare.RMS_BLOCK)
 RMS_BLOCK = 2
 #: the name of the RMS's error from fixed blocks of RMS_BLOCK periods in :func:`calibration_study`
 SHORT_BLOCKS = f"RMS, blocks of {RMS_BLOCK}"

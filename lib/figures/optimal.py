@@ -11,7 +11,7 @@ __all__ = ["plot_cap_bound", "plot_motions", "plot_force_maps", "plot_basin"]
 
 def plot_cap_bound(bounds: dict, paper: dict, ax=None):
     """The largest distance |C - C_d| (m) against the cap (N), one panel a path: the certified
-    lower bound and the achieved motion of :func:`lib.optimal.study.cap_sweep` (a band between
+    lower bound and the achieved motion of :func:`lib.optimal.studies.study.cap_sweep` (a band between
     them), the paper's saturated law (:func:`lib.tracking.runs.force_cap_sweep`) as points, and
     the exact-tracking demand as a dotted line.
 
@@ -95,7 +95,7 @@ def plot_force_maps(maps, ax=None):
     Parameters
     ----------
     maps : pandas.DataFrame
-        :func:`lib.optimal.demand.exact_force_maps`: columns R (m), Theta (rad/s), F_C, F_P (N), ratio.
+        :func:`lib.optimal.studies.demand.exact_force_maps`: columns R (m), Theta (rad/s), F_C, F_P (N), ratio.
     ax : sequence of matplotlib.axes.Axes, optional
         Three axes.
 
@@ -155,13 +155,13 @@ def plot_basin(frame, title: str = "", ax=None):
 
 
 def plot_entry(entry, motion, path, title: str = "", ax=None):
-    """An entry manoeuvre (:func:`lib.optimal.collocation.entry_motion`): the path (dashed), C's
+    """An entry manoeuvre (:func:`lib.optimal.entry.entry_motion`): the path (dashed), C's
     path during the entry from the start (cross) to its end (circle, on the motion), and the
     motion's path over one period after it.
 
     Parameters
     ----------
-    entry : lib.optimal.collocation.Entry
+    entry : lib.optimal.entry.Entry
         The entry (its ``path``: t (s), x, y (m)).
     motion : PeriodicMotion
         The motion it enters.

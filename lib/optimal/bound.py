@@ -39,17 +39,15 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import minimize_scalar
 
-from ..dynamics.orbits import floquet_multipliers, newton
 from ..machinery import checks
 from ..machinery.summary import Summarised
 from ..params import Body
-from ..trajectories import KINEMATICS, POSITIONS, heading_turns, make
+from ..trajectories import KINEMATICS, POSITIONS
 
 if TYPE_CHECKING:  # imported where used: cvxpy loads in about 0.5 s, most pages never call it
     import cvxpy as cp
 
-__all__ = ["IntervalMap", "interval_map", "exact_peak_force", "CapBound", "cap_bound", "MAX_NODES", "heading_orbit",
-           "HEADING_SUBSTEPS", "HEADING_TOL"]
+__all__ = ["IntervalMap", "interval_map", "exact_peak_force", "CapBound", "cap_bound", "MAX_NODES"]
 
 #: the most nodes :func:`cap_bound` accepts (its problems grow linearly with them)
 MAX_NODES = 20000
@@ -429,69 +427,3 @@ def cap_bound(body: Body, R: float, Theta: float, F_max: float, *, kind: str = "
                     C=C, V=(p - body.c * C) / body.m, F=F,
                     C_rms=Cr, V_rms=(pr - body.c * Cr) / body.m, F_rms=Fr,
                     gap=max(gaps), kind=kind, R=R, Theta=Theta, F_max=F_max, nodes=N)
-
-
-#: RK4 steps a node interval of the heading under a held force (:func:`heading_orbit`): the period
-#: map's error (order h^4, h = T / (16 N)) lies far below Newton's tolerance
-HEADING_SUBSTEPS = 16
-#: Newton's tolerance on the heading's period map (rad, rad/s); periods of transient before it
-HEADING_TOL, HEADING_TRANSIENT = 1e-10, 4
-
-
-def _heading_run(body: Body, Fw: np.ndarray, h: float, x: np.ndarray, record: bool = False):
-    """(phi, phi') of rows x (M, 2) over one period under the world force Fw (N, 2) held on intervals
-    of h (s): I phi'' + c_phi phi' = a (Fw_y cos phi - Fw_x sin phi), eq. (4) with F sin beta the
-    force across the axis; RK4, HEADING_SUBSTEPS steps an interval, with its variational equation.
-    Returns P(x) (M, 2), DP (M, 2, 2) and, with ``record``, every step's state (steps + 1, M, 2)."""
-    dt, M = h / HEADING_SUBSTEPS, x.shape[0]
-    J, grid = np.tile(np.eye(2), (M, 1, 1)), [x]
-
-    def f(y, J, fx, fy):
-        c, s = np.cos(y[:, 0]), np.sin(y[:, 0])
-        A = np.zeros((M, 2, 2))
-        A[:, 0, 1], A[:, 1, 0], A[:, 1, 1] = 1.0, -body.a * (fy * s + fx * c) / body.I, -body.c_phi / body.I
-        return np.stack([y[:, 1], (body.a * (fy * c - fx * s) - body.c_phi * y[:, 1]) / body.I], -1), A @ J
-    for fx, fy in Fw:
-        for _ in range(HEADING_SUBSTEPS):
-            k1, K1 = f(x, J, fx, fy)
-            k2, K2 = f(x + dt / 2 * k1, J + dt / 2 * K1, fx, fy)
-            k3, K3 = f(x + dt / 2 * k2, J + dt / 2 * K2, fx, fy)
-            k4, K4 = f(x + dt * k3, J + dt * K3, fx, fy)
-            x, J = x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4), J + dt / 6 * (K1 + 2 * K2 + 2 * K3 + K4)
-            if record:
-                grid.append(x)
-    return x, J, (np.stack(grid) if record else None)
-
-
-def heading_orbit(body: Body, bound: CapBound, objective: str = "rms") -> tuple[np.ndarray, np.ndarray, float, int]:
-    """The heading's period-1 orbit without slip under the held world force of :func:`cap_bound`'s
-    achieved motion (``objective`` "max": ``bound.F``; "rms": ``bound.F_rms``), with beta pointing
-    the force where that force points (eq. (4)). Located, not waited for: Newton on the period map
-    (:func:`lib.dynamics.orbits.newton`, the exact Jacobian of the RK4 map, tol :data:`HEADING_TOL`,
-    the path's turns of the heading a period) from the heading along the force at t = 0 after
-    :data:`HEADING_TRANSIENT` periods; RuntimeError if Newton does not converge.
-
-    Returns
-    -------
-    grid : numpy.ndarray
-        (nodes HEADING_SUBSTEPS + 1, 2) phi (rad), phi' (rad/s) at the RK4 steps over one period.
-    multipliers : numpy.ndarray
-        (2,) the orbit's Floquet multipliers (complex, decreasing modulus).
-    residual : float
-        Newton's residual (max-norm, rad and rad/s).
-    turns : int
-        Whole turns of the heading a period (the path's).
-    """
-    checks.instance("body", body, Body)
-    checks.instance("bound", bound, CapBound)
-    Fw = bound.F_rms if checks.one_of("objective", objective, ("max", "rms")) == "rms" else bound.F
-    turns, h = heading_turns(make(bound.kind, bound.R, bound.Theta)), 2 * math.pi / bound.Theta / bound.nodes
-    x = np.array([[math.atan2(Fw[0, 1], Fw[0, 0]), 0.0]])
-    for _ in range(HEADING_TRANSIENT):
-        x = _heading_run(body, Fw, h, x)[0] - [2 * math.pi * turns, 0.0]
-    res = newton(lambda i, y, k: _heading_run(body, Fw, h, y)[:2], np.zeros(1, int), x, 1, turns=[turns],
-                 tol=HEADING_TOL, max_iter=20)
-    if not res.residual[0] <= HEADING_TOL:
-        raise RuntimeError(f"heading_orbit: Newton found no period-1 orbit (residual {res.residual[0]:.3g})")
-    return (_heading_run(body, Fw, h, res.x, record=True)[2][:, 0], floquet_multipliers(res.jacobian[0]),
-            float(res.residual[0]), turns)

@@ -31,21 +31,18 @@ from ..closed_loop import _weighted_rows
 from ..dynamics import verdicts as dv
 from ..dynamics.sampled import sampled_extremes
 from ..integrators.batch import RK4, fixed_steps, integrate, nonfinite_message
-from ..integrators.smooth import Integration, SimulationError
+from ..integrators.smooth import SimulationError
 from ..machinery import checks
 from ..machinery.cache import source_stamp
 from ..percussion import full_loop
 from ..percussion.full_loop import _rows_field
-from .verdict import ORBIT_SHIFT_TOL, multiplier_tolerance, multipliers_agree
+from .floquet import multiplier_tolerance, multipliers_agree
+from .verdict import BLOWUP, ORBIT_SHIFT_TOL       # a state beyond BLOWUP has blown up
 
 __all__ = ["FlowMap", "LoopVerdict", "loop_verdict", "halved_verdict", "run_periods", "steady_measures",
            "LOOP_OPTIONS", "rows_period_end"]
 
 Rates = Callable[[float, np.ndarray], np.ndarray]
-
-#: a state beyond this magnitude (m, rad, m/s, rad/s) has blown up; the bound of
-#: :class:`lib.integrators.smooth.Integration`
-BLOWUP = Integration.blowup
 
 #: the procedure's settings here (state units; m, rad, m/s, rad/s); periods run before the orbit
 #: search, section states kept, longest period tried, and the tolerances of
@@ -406,7 +403,7 @@ def halved_verdict(rates: Rates, period: float, s0, *, steps: int, max_steps: in
     The two agree when they give the same regime, period and turns and, where they find an
     orbit, the orbit moves by at most :data:`lib.optimal.verdict.ORBIT_SHIFT_TOL` (max-norm,
     state units; to the nearest point of the finer map's cycle, the heading modulo 2 pi) and its
-    largest |Floquet multiplier| agrees (:func:`lib.optimal.verdict.multipliers_agree`, relative), the
+    largest |Floquet multiplier| agrees (:func:`lib.optimal.floquet.multipliers_agree`, relative), the
     tolerances of the optimal tracker's verdict. For a method of order p the finer map's error is
     about the shift / (2^p - 1): the shift itself where RK4 keeps only p = 1 across the kinks and
     the chattering of a clipped input (Chapter 8's loops: the shift halves with the step), a

@@ -5,14 +5,14 @@ paper's limits (Sec. 5): how close to the path any controller can keep C.
 (T = 2 pi / Theta; n = 0 on the eight, 1 on the circle) under F >= 0, F <= F_max, |beta| <= beta_max
 that minimises the RMS distance of C from C_d(t), by collocation solved by IPOPT
 (:mod:`lib.optimal.collocation`) from several starts (not convex: a best found); :func:`reintegrated`
-integrates its inputs, a motion of the model; :func:`held_force_motion` makes the convex bound's
-achieved motions motions of the full model.
+integrates its inputs, a motion of the model; :func:`lib.optimal.held.held_force_motion` makes the
+convex bound's achieved motions motions of the full model.
 
 Defaults and cost: 80 intervals of degree-3 Legendre collocation (2080 unknowns), starts "paper",
 "force", "shifted+-" and, under a cap alone, "convex"; a solve takes about 0.3 to 1.3 s of CPU.
 The inputs are held in the body's frame on each interval, so the force turns with the heading
 within it: with a cap the best found RMS error falls as h^2 with the mesh (Chapter 8 refines each
-motion and extrapolates, :func:`lib.optimal.study.richardson`); without one the optimum asks for
+motion and extrapolates, :func:`lib.optimal.studies.study.richardson`); without one the optimum asks for
 force pulses whose peak grows as the mesh refines. The starts meet one optimum at the meshes the
 book tries; that says no better one was met, not that none exists.
 """
@@ -21,20 +21,20 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from functools import lru_cache
 
 import numpy as np
 
 from ..machinery import checks
+from ..machinery.summary import Summarised
 from ..model import config_from_state, state_from_config
 from ..params import Body
 from ..simulate import simulate_open_loop
 from ..trajectories import KINEMATICS, heading_turns, make
-from .bound import HEADING_SUBSTEPS, CapBound, _phi2, cap_bound, heading_orbit
+from .held import _convex_held
 from .collocation import ACCEPTED, FREE_ANGLE, _bounds, _clip, _guess_start, _max_error, _start, tableau, transcription
 
 __all__ = ["PeriodicMotion", "periodic_motion", "verify_motion", "return_errors", "reintegrated", "STARTS",
-           "START_TIE", "MAX_NODES", "FREE_ANGLE", "HeldForceMotion", "held_force_motion"]
+           "START_TIE", "MAX_NODES", "FREE_ANGLE", "MOTION_RETURN_TOL", "check_motion_body", "run_held_inputs"]
 
 #: the starts :func:`periodic_motion` knows ("shifted" is two solves, +- beta_max / 2; "convex"
 #: needs a cap)
@@ -50,10 +50,13 @@ FREE_SHIFT = math.pi / 4
 NODE_SNAP = 1e-9
 #: Gauss-Legendre points an interval of :func:`reintegrated`'s RMS
 QUADRATURE = 6
+#: the most a motion's inputs may miss returning it to its start on the given body (max-norm, state
+#: units) for it to count as that body's motion (:func:`check_motion_body`): the reach tolerance
+MOTION_RETURN_TOL = 1e-3
 
 
-@dataclass(frozen=True)
-class PeriodicMotion:
+@dataclass(frozen=True, repr=False)
+class PeriodicMotion(Summarised):
     """An optimal periodic motion on a path (one period), as :func:`periodic_motion` returns it.
 
     Attributes
@@ -195,101 +198,6 @@ def _check_starts(starts, guesses, F_max, beta_max) -> tuple:
     return tuple(dict.fromkeys(starts))
 
 
-@dataclass(frozen=True)
-class HeldForceMotion:
-    """A periodic motion of the full model (2)-(4) whose world-frame force ``Fw`` (N, (N, 2)) is held
-    on each node interval (:func:`held_force_motion`): C (m) and V (m/s) at the nodes ``t`` (s, (N,))
-    as :func:`lib.optimal.bound.cap_bound`'s achieved motion (closed form between them); the heading
-    on its period-1 orbit under that force (:func:`lib.optimal.bound.heading_orbit`: ``heading``
-    (N S + 1, 2) (rad, rad/s) at its RK4 steps, its ``multipliers`` and Newton's ``residual``);
-    F = |Fw| (N), beta the force's angle less phi (rad, continuous within an interval). It has what
-    :mod:`lib.optimal.tracker` asks of a motion: period (s), kind, R (m), Theta (rad/s), F_max (N),
-    beta_max (None), turns, ``state(t)``, ``inputs(t)``, the input breaks ``t``."""
-
-    body: Body
-    t: np.ndarray
-    C: np.ndarray
-    V: np.ndarray
-    Fw: np.ndarray
-    heading: np.ndarray
-    multipliers: np.ndarray
-    residual: float
-    period: float
-    kind: str
-    R: float
-    Theta: float
-    F_max: float
-    turns: int
-    objective: str
-    beta_max: None = None
-
-    def _heading(self, t):
-        """(interval k, phi, phi') at times t (s), any shape: cubic Hermite on the RK4 steps, with
-        the rates of eq. (4) at both ends (the steps never straddle a node)."""
-        t = np.asarray(t, dtype=float)
-        laps = np.floor(t / self.period)
-        dt = self.period / self.t.size / HEADING_SUBSTEPS
-        x = (t - laps * self.period) / dt
-        j = np.clip(np.floor(x).astype(int), 0, self.heading.shape[0] - 2)
-        k, r, b = j // HEADING_SUBSTEPS, x - j, self.body
-        (p0, w0), (p1, w1) = np.moveaxis(self.heading[j], -1, 0), np.moveaxis(self.heading[j + 1], -1, 0)
-        fx, fy = self.Fw[k][..., 0], self.Fw[k][..., 1]
-        a0, a1 = ((b.a * (fy * np.cos(p) - fx * np.sin(p)) - b.c_phi * w) / b.I for p, w in ((p0, w0), (p1, w1)))
-        h00, h10, h01, h11 = 2 * r**3 - 3 * r**2 + 1, dt * (r**3 - 2 * r**2 + r), 3 * r**2 - 2 * r**3, dt * (r**3 - r**2)
-        phi = h00 * p0 + h10 * w0 + h01 * p1 + h11 * w1 + 2 * np.pi * self.turns * laps
-        return k, phi, h00 * w0 + h10 * a0 + h01 * w1 + h11 * a1
-
-    def state(self, t) -> tuple[np.ndarray, np.ndarray]:
-        """Configuration (m, m, rad) and rate (m/s, m/s, rad/s) at times t (s), t.shape + (3,)."""
-        k, phi, dphi = self._heading(t)
-        b, kap = self.body, self.body.c / self.body.m
-        r = (np.asarray(t, dtype=float) % self.period - self.t[k])[..., None]
-        p = b.m * self.V[k] + b.c * self.C[k]
-        C = np.exp(-kap * r) * self.C[k] - np.expm1(-kap * r) / b.c * p + self.Fw[k] * _phi2(kap * r) / (b.m * kap**2)
-        V = np.exp(-kap * r) * self.V[k] - np.expm1(-kap * r) / b.c * self.Fw[k]
-        return np.concatenate([C, phi[..., None]], -1), np.concatenate([V, dphi[..., None]], -1)
-
-    def inputs(self, t) -> tuple[np.ndarray, np.ndarray]:
-        """F (N) and beta (rad) at times t (s), shape t.shape."""
-        k, phi, _ = self._heading(t)
-        fx, fy = self.Fw[k][..., 0], self.Fw[k][..., 1]
-        return np.hypot(fx, fy), np.angle(np.exp(1j * (np.arctan2(fy, fx) - phi)))
-
-
-def held_force_motion(body: Body, bound: CapBound, objective: str = "rms") -> HeldForceMotion:
-    """:func:`lib.optimal.bound.cap_bound`'s achieved motion of ``objective`` ("max" or "rms") as a
-    motion of the full model (2)-(4), its heading on the period-1 orbit that
-    :func:`lib.optimal.bound.heading_orbit` locates under the held force (RuntimeError without one).
-
-    Parameters
-    ----------
-    body : Body
-        The body the bound was computed for.
-    bound : CapBound
-        The bound.
-    objective : str
-        ``"max"`` (the largest distance's motion) or ``"rms"``.
-
-    Returns
-    -------
-    HeldForceMotion
-        The motion, with its heading orbit's multipliers and residual.
-    """
-    grid, mult, res, turns = heading_orbit(body, bound, objective)
-    rms = objective == "rms"
-    return HeldForceMotion(body=body, t=bound.t, C=bound.C_rms if rms else bound.C, V=bound.V_rms if rms else bound.V,
-                           Fw=bound.F_rms if rms else bound.F, heading=grid, multipliers=mult, residual=res,
-                           period=2 * math.pi / bound.Theta, kind=bound.kind, R=bound.R, Theta=bound.Theta,
-                           F_max=bound.F_max, turns=turns, objective=objective)
-
-
-@lru_cache(maxsize=8)
-def _convex_held(body: Body, kind: str, R: float, Theta: float, F_max: float, nodes: int) -> HeldForceMotion:
-    """The "convex" start's motion: the RMS-optimal held-force motion of the cap's convex problem
-    at ``nodes`` (at least 16) nodes (cached: the continuation and the multistart reuse it)."""
-    return held_force_motion(body, cap_bound(body, R, Theta, F_max, kind=kind, nodes=max(nodes, 16)), "rms")
-
-
 def periodic_motion(body: Body, R: float, Theta: float, *, kind: str = "eight", F_max: float | None = None,
                     beta_max: float | None = None, nodes: int = 80, degree: int = 3, guess=None,
                     starts=None, shifts=()) -> PeriodicMotion:
@@ -305,7 +213,7 @@ def periodic_motion(body: Body, R: float, Theta: float, *, kind: str = "eight", 
     -beta_max / 2 (two solves; +-pi/4 without an angle limit); ``"convex"``, the optimum of
     the cap's convex problem (:func:`lib.optimal.bound.cap_bound` at ``nodes`` nodes, its
     RMS-optimal held world force, with the heading on its periodic orbit under that force,
-    :func:`held_force_motion`; needs ``F_max``, its beta clipped into an angle limit); and each
+    :func:`lib.optimal.held.held_force_motion`; needs ``F_max``, its beta clipped into an angle limit); and each
     motion in ``guess``, interpolated onto the mesh (continuation in beta_max).
 
     Parameters
@@ -429,6 +337,73 @@ def _best(tr, jobs, par, F_max, beta_max) -> tuple[np.ndarray, np.ndarray, tuple
     return X, u, tuple(table)
 
 
+def run_held_inputs(body: Body, q: np.ndarray, F, beta, h: float, *, te=None, rtol: float = 1e-10,
+                    atol: float = 1e-10) -> tuple[np.ndarray, np.ndarray | None]:
+    """The model (2)-(4) under inputs held on intervals of ``h`` (s), F[k] (N) and beta[k] (rad) on
+    the k-th, from the state ``q`` (state form of :func:`lib.model.state_from_config`), by the book's
+    integrator (:func:`lib.simulate.simulate_open_loop`) interval by interval, so that it never steps
+    across a jump of the inputs: the one integration of a motion's or an entry's inputs.
+
+    Parameters
+    ----------
+    body : Body
+        The body.
+    q : numpy.ndarray
+        (6,) the start, state form.
+    F, beta : array_like
+        (K,) the held inputs.
+    h : float
+        The interval (s), > 0.
+    te : array_like, optional
+        Times within an interval (s, in (0, h)) at which to record the state on every interval.
+    rtol, atol : float
+        The integrator's tolerances.
+
+    Returns
+    -------
+    end : numpy.ndarray
+        (6,) the state after the K intervals, state form.
+    samples : numpy.ndarray or None
+        (K, len(te), 6) the states at ``te`` on each interval, state form (None without ``te``).
+    """
+    te = None if te is None else np.asarray(te, dtype=float)
+    t_eval = np.array([h]) if te is None else np.r_[te, h]
+    samples = []
+    for Fk, bk in zip(np.asarray(F, dtype=float), np.asarray(beta, dtype=float)):
+        qs = simulate_open_loop(body, lambda t, F=Fk: F, lambda t, b=bk: b, q, h, form="config", t_eval=t_eval,
+                                rtol=rtol, atol=atol)[1]
+        samples.append(qs[:-1])
+        q = qs[-1]
+    return q, (None if te is None else np.stack(samples))
+
+
+def check_motion_body(body: Body, motion) -> None:
+    """Refuse a motion of :func:`periodic_motion` that is not a motion of ``body``: its inputs, run on
+    ``body``'s model (:func:`verify_motion`), miss returning it to its start by more than
+    :data:`MOTION_RETURN_TOL`. (A motion does not record the body it was solved for; a duck-typed
+    motion is taken as given.)
+
+    Parameters
+    ----------
+    body : Body
+        The body the caller will run the motion on.
+    motion : PeriodicMotion or a duck-typed motion
+        The motion.
+
+    Raises
+    ------
+    ValueError
+        Naming the body and the miss.
+    """
+    if not isinstance(motion, PeriodicMotion):
+        return
+    miss = verify_motion(body, motion)
+    if not miss <= MOTION_RETURN_TOL:
+        raise ValueError(f"motion is not a periodic motion of body = {body}: its inputs on that body miss returning "
+                         f"it to its start by {miss:.3g} (max-norm of m, rad, m/s, rad/s; at most "
+                         f"{MOTION_RETURN_TOL:g}); solve it for this body (lib.optimal.periodic_motion(body, ...))")
+
+
 def _return_mismatch(body: Body, motion: PeriodicMotion, rtol, atol) -> tuple[np.ndarray, float]:
     """X(T) - X(0) - (0, 0, 2 pi n, 0, 0, 0) (6,) of a motion's inputs integrated over one period, and
     the RMS distance (m) of the integrated C from the path, by Gauss-Legendre quadrature of
@@ -437,15 +412,11 @@ def _return_mismatch(body: Body, motion: PeriodicMotion, rtol, atol) -> tuple[np
     checks.instance("motion", motion, PeriodicMotion)
     rtol, atol = checks.number("rtol", rtol, positive=True), checks.number("atol", atol, positive=True)
     z0, dz0 = motion.state(0.0)
-    q, sq = state_from_config(z0, dz0), 0.0
     h, ref = motion.period / motion.nodes, make(motion.kind, motion.R, motion.Theta)
     s, w = np.polynomial.legendre.leggauss(QUADRATURE)
     te = h * (s + 1) / 2
-    for k in range(motion.nodes):
-        _, qs = simulate_open_loop(body, lambda t, F=float(motion.F[k]): F, lambda t, b=float(motion.beta[k]): b, q,
-                                   h, form="config", t_eval=np.r_[te, h], rtol=rtol, atol=atol)
-        sq += w @ ((qs[:-1, :2] - ref.z(motion.t[k] + te)[:, :2]) ** 2).sum(1) / 2
-        q = qs[-1]
+    q, qs = run_held_inputs(body, state_from_config(z0, dz0), motion.F, motion.beta, h, te=te, rtol=rtol, atol=atol)
+    sq = sum(w @ ((qs[k, :, :2] - ref.z(motion.t[k] + te)[:, :2]) ** 2).sum(1) / 2 for k in range(motion.nodes))
     X1 = np.concatenate(config_from_state(q)) - np.concatenate([z0, dz0]) - [0, 0, 2 * np.pi * motion.turns, 0, 0, 0]
     return X1, math.sqrt(sq / motion.nodes)
 

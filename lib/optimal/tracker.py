@@ -29,7 +29,7 @@ from ..model import config_accel, generalized_force
 from ..params import PAPER_DZ0, PAPER_Z0, Body
 from ..simulate import DEFAULT_RATE, SimulationResult
 from ..trajectories import make
-from .motion import PeriodicMotion, verify_motion
+from .motion import MOTION_RETURN_TOL, check_motion_body
 from .riccati import closed_loop_rhs, loop_rhs, riccati_rhs
 
 __all__ = ["PeriodicLQR", "jacobians", "periodic_lqr", "track_motion",
@@ -53,9 +53,6 @@ REACH_TOL, REACH_FLOOR = 1e-3, 1e-6
 MAX_RICCATI_PERIODS, RICCATI_SETTLE = 50, 1e-8
 #: the most output times :func:`track_motion` records by default (about 20 floats a time: 160 MB)
 MAX_SAMPLES = 1e6
-#: the most a motion's inputs may miss returning it to its start on the given body (max-norm, state
-#: units) for :func:`periodic_lqr` to take it as that body's: the reach tolerance
-MOTION_RETURN_TOL = 1e-3
 #: motion_verdict's 7 starts at t = 0; the paper's, then it +-0.5 m in x, +-0.5 m in y, +-pi/2 rad in phi
 DEFAULT_STARTS = np.concatenate([PAPER_Z0, PAPER_DZ0]) + np.array(
     [np.zeros(6)] + [sign * d * np.eye(6)[j] for j, d in ((0, 0.5), (1, 0.5), (2, np.pi / 2)) for sign in (1, -1)])
@@ -86,20 +83,6 @@ def _check_motion(motion: Any) -> None:
     for name, v, shape in (("state(t)[0]", z, (1, 3)), ("state(t)[1]", dz, (1, 3)), ("inputs(t)[0]", F, (1,)),
                            ("inputs(t)[1]", beta, (1,))):
         checks.array("motion." + name, v, shape=shape)
-
-
-def _check_body(body: Body, motion) -> None:
-    """Refuse a motion of :func:`lib.optimal.motion.periodic_motion` that is not a motion of ``body``:
-    its inputs, run on ``body``'s model (:func:`lib.optimal.motion.verify_motion`), miss returning
-    it to its start by more than :data:`MOTION_RETURN_TOL`. (A motion does not record the body it was
-    solved for; a duck-typed motion is taken as given.)"""
-    if not isinstance(motion, PeriodicMotion):
-        return
-    miss = verify_motion(body, motion)
-    if not miss <= MOTION_RETURN_TOL:
-        raise ValueError(f"motion is not a periodic motion of body = {body}: its inputs on that body miss returning "
-                         f"it to its start by {miss:.3g} (max-norm of m, rad, m/s, rad/s; at most "
-                         f"{MOTION_RETURN_TOL:g}); solve it for this body (lib.optimal.periodic_motion(body, ...))")
 
 
 def _weights(Q, R_weight) -> tuple[np.ndarray, np.ndarray]:
@@ -308,7 +291,7 @@ def periodic_lqr(body: Body, motion, *, Q=None, R_weight=None, samples: int = 10
     _check_motion(motion)
     Q, R = _weights(Q, R_weight)
     samples = checks.integer("samples", samples, minimum=16)
-    _check_body(body, motion)
+    check_motion_body(body, motion)
     Rinv, T = np.linalg.inv(R), float(motion.period)
 
     fast = riccati_rhs(body, motion, Q, Rinv)      # compiled, for the motions of periodic_motion

@@ -54,29 +54,20 @@ from ..dynamics.verdicts import reached
 from ..integrators.batch import RK4, fixed_steps, integrate
 from ..integrators.smooth import Integration, SimulationError
 from ..machinery import checks
-from ..machinery.kinds import Number, numerical
-from ..model import config_accel
 from ..params import Body
+from .floquet import MULTIPLIER_RTOL, MULTIPLIER_TOL, multipliers_agree
 from .riccati import loop_steps
 from .tracker import (DEFAULT_STARTS, NEWTON_ITER, NEWTON_STALL, NEWTON_TOL, REACH_FLOOR, REACH_TOL, RTOL,
-                      PeriodicLQR, _check_loop, _edges, _inside, _inside_bounds, _limits, _loop, _loop_inputs,
-                      _loop_reference, _piecewise_ivp, _reference, periodic_lqr)
+                      PeriodicLQR, _check_loop, _edges, _inside_bounds, _limits, _loop, _piecewise_ivp, _reference,
+                      periodic_lqr)
 
-__all__ = ["MotionVerdict", "motion_verdict", "pushed_verdict", "basin", "offset_starts", "multipliers_agree",
-           "multiplier_tolerance", "floquet_estimate", "floquet_text", "largest_floquet", "ORBIT_SHIFT_TOL",
-           "MULTIPLIER_TOL", "MULTIPLIER_RTOL", "MULTIPLIER_ATOL", "KINK_STEP", "RESOLVE", "FINE_RTOL"]
+__all__ = ["MotionVerdict", "motion_verdict", "basin", "offset_starts", "ORBIT_SHIFT_TOL", "KINK_STEP", "RESOLVE",
+           "FINE_RTOL"]
 
 #: the most the orbit may move (max-norm, state units) when the step is halved, a tenth of the
 #: reach tolerance :data:`lib.optimal.tracker.REACH_TOL`, so that a start's distance to it is
 #: decided by the dynamics, not by the step
 ORBIT_SHIFT_TOL = 0.1 * REACH_TOL
-#: the most two values of |mu_1| may differ and agree (:func:`multiplier_tolerance`): MULTIPLIER_RTOL of
-#: the larger (a factor 2 differs by half the larger: told apart), never more than MULTIPLIER_TOL (as the
-#: verdict reads |mu_1| < 1, and the reach test |mu_1| ** (periods / 2) against a factor 3), and never
-#: less than MULTIPLIER_ATOL: at |mu_1| <= 0.005 the reach test's term 3 d |mu_1| ** 4 (over the chapter's
-#: 8 periods) is below 2e-9 d, three orders under its floor for any start within a metre, so two
-#: multipliers that small are alike to both readings (a factor 2 above it is told apart)
-MULTIPLIER_TOL, MULTIPLIER_RTOL, MULTIPLIER_ATOL = 0.05, 0.25, 5e-3
 #: the differencing step, in units of the verdict's step h, that crosses the clip's kinks beside the orbit
 #: (the RK4 orbit sits off them by its O(h^2) error, about 1e-5 state units): its one-sided
 #: quotients are those of the kink's other side, and enter the multiplier's stated error
@@ -124,80 +115,6 @@ class MotionVerdict:
     multiplier_spread: float = math.nan
     settled: np.ndarray | None = None
     multiplier_error: float = math.nan
-
-
-def floquet_estimate(value: float, error: float) -> Number:
-    """A largest |Floquet multiplier| from differences as the book writes it, everywhere: a
-    numerical estimate ``value ± error`` (:func:`lib.machinery.kinds.numerical`) to the decimal
-    of the error's second significant digit, at least 3 decimals and at most the value's third
-    significant digit: ``0.030 ± 0.023``, ``0.0028 ± 0.0013``, ``0.000934 ± 0.000001``.
-
-    Parameters
-    ----------
-    value, error : float
-        |mu_1| and its stated error (:class:`MotionVerdict`), finite, >= 0.
-
-    Returns
-    -------
-    Number
-    """
-    value, error = checks.number("value", value, nonnegative=True), checks.number("error", error, nonnegative=True)
-
-    def decimals(x, digits):
-        return digits - 1 - math.floor(math.log10(x)) if x > 0 else 3
-    return numerical(value, error, f".{max(3, min(decimals(error, 2), decimals(value, 3)))}f")
-
-
-def floquet_text(value: float, error: float) -> str:
-    """:func:`floquet_estimate`'s text, or "-" where the row has no multiplier or no error (no orbit)."""
-    ok = math.isfinite(value) and math.isfinite(error)
-    return floquet_estimate(value, error).text() if ok else "-"
-
-
-def largest_floquet(frame: pd.DataFrame) -> Number:
-    """The largest |mu_1| of a table's rows (columns ``floquet`` and ``floquet_error``, as
-    :func:`lib.optimal.compare.side_by_side` and :func:`lib.optimal.margins.tracked_case` give
-    them) with that row's error, as :func:`floquet_estimate` writes it: the page's prose, its
-    tables and the report print the same text.
-
-    Parameters
-    ----------
-    frame : pandas.DataFrame
-        Rows with finite ``floquet``.
-
-    Returns
-    -------
-    Number
-    """
-    checks.instance("frame", frame, pd.DataFrame)
-    if not {"floquet", "floquet_error"} <= set(frame.columns) or not np.isfinite(frame.floquet).any():
-        raise ValueError("frame must have the columns floquet and floquet_error, with a finite floquet")
-    row = frame.loc[frame.floquet.idxmax()]
-    return floquet_estimate(float(row.floquet), float(row.floquet_error))
-
-
-def multiplier_tolerance(a: float, b: float) -> float:
-    """How far two values of |mu_1| may lie apart and agree: :data:`MULTIPLIER_RTOL` of the larger
-    modulus, at most :data:`MULTIPLIER_TOL` and at least :data:`MULTIPLIER_ATOL`."""
-    big = max(abs(a), abs(b))
-    return max(MULTIPLIER_ATOL, min(MULTIPLIER_TOL, MULTIPLIER_RTOL * big))
-
-
-def multipliers_agree(a: float, b: float) -> bool:
-    """Whether two values of |mu_1| agree, relatively (:func:`multiplier_tolerance`): 0.008 and
-    0.03 do not, nor does any pair a factor 2 apart above :data:`MULTIPLIER_ATOL`; NaN never does.
-
-    Parameters
-    ----------
-    a, b : float
-        The two moduli (dimensionless).
-
-    Returns
-    -------
-    bool
-    """
-    a, b = float(a), float(b)
-    return bool(math.isfinite(a) and math.isfinite(b) and abs(a - b) <= multiplier_tolerance(a, b))
 
 
 def _period_map(lqr: PeriodicLQR, F_max, beta_max, steps: int = 0, rtol: float = RTOL):
@@ -498,92 +415,3 @@ def basin(body: Body, motion, verdict: MotionVerdict, *, limits: Limits | None =
     hit = (d[0] < REACH_TOL, d[1] < REACH_TOL)
     return pd.DataFrame(dict(heading_offset=H.ravel(), x_offset=X.ravel(), distance=d[1], reached=hit[0] & hit[1],
                              settled=hit[0] == hit[1]))
-
-
-def _pushed_loop(lqr: PeriodicLQR, F_max: float, beta_max, rows: int, push, memo: dict):
-    """The clipped loop's rates on an input piece, as :func:`lib.optimal.tracker.track_motion`'s,
-    plus the constant world-frame force ``push`` (N) on the body ``lqr.body``; ``memo`` keeps
-    (x*, u*, K) by (t, lo, hi), which fixed steps meet every period."""
-    body, (px, py) = lqr.body, push
-
-    def piece(lo, hi):
-        def rhs(t, s):
-            X = s.reshape(rows, 6)
-            ref = memo.get((t, lo, hi))
-            if ref is None:
-                ref = memo[t, lo, hi] = _loop_reference(lqr, t, _inside(t, lo, hi))
-            F, beta = _loop_inputs(lqr, t, X, F_max, beta_max, ref=ref)
-            acc = config_accel(body, X[:, :3], X[:, 3:], F, beta)
-            acc[:, 0] += px / body.m
-            acc[:, 1] += py / body.m
-            out = np.concatenate([X[:, 3:], acc], -1).ravel()
-            if not np.all(np.isfinite(out)):
-                raise SimulationError(f"pushed loop became non-finite at t = {t:.6g} s")
-            return out
-        return rhs
-    return piece
-
-
-def _pushed_map(lqr: PeriodicLQR, F_max, beta_max, steps: int, push):
-    """The pushed loop's period map (as :func:`_period_map` with ``steps``
-    RK4 steps an input piece): x (M, 6) at t = 0 -> one period later, less the heading's turns."""
-    motion = lqr.motion
-    shift, edges, memo = 2 * np.pi * motion.turns * np.eye(6)[2], _edges(motion, 0.0, motion.period), {}
-
-    def advance(X):
-        y = X.ravel()
-        try:
-            for a, b in zip(edges[:-1], edges[1:]):
-                y = integrate(_pushed_loop(lqr, F_max, beta_max, X.shape[0], push, memo)(a, b), y, a, b,
-                              (b - a) / steps, RK4)[1][-1]
-        except FloatingPointError as err:
-            raise SimulationError(f"the pushed period map blew up: {err}") from None
-        return y.reshape(X.shape) - shift
-    return advance
-
-
-def pushed_verdict(body: Body, motion, push, *, limits: Limits | None = None, lqr: PeriodicLQR | None = None,
-                   starts=None, periods: int = 20, steps: int = 8, h: float = 1e-5) -> MotionVerdict:
-    """:func:`motion_verdict` of the loop with a constant world-frame force ``push`` = (Fx, Fy)
-    (N) on ``body``: Newton on two RK4 maps (``steps`` and twice as many steps an input piece,
-    doubled while the orbit moves by more than :data:`ORBIT_SHIFT_TOL`), the multipliers, and the
-    starts' reach test, by the same decision. Integrated in numpy (no compiled kernel takes a
-    push): about a second of CPU a verdict at Chapter 8's steps.
-
-    Parameters
-    ----------
-    body, motion, limits, lqr
-        As in :func:`motion_verdict` (``lqr`` may be a :func:`lib.optimal.margins.plant_lqr`).
-    push : array_like
-        (Fx, Fy) (N), world frame.
-    starts, periods, steps, h
-        As in :func:`motion_verdict`.
-
-    Returns
-    -------
-    MotionVerdict
-    """
-    checks.instance("body", body, Body)
-    push = tuple(float(p) for p in checks.array("push", push, shape=(2,)))
-    steps = checks.integer("steps", steps, minimum=1)
-    periods = checks.integer("periods", periods, minimum=2)
-    lqr = lqr or periodic_lqr(body, motion)
-    if lqr.body != body or lqr.motion is not motion:
-        raise ValueError("lqr must be a periodic LQR of this body and motion")
-    starts = checks.array("starts", DEFAULT_STARTS if starts is None else starts, shape=(None, 6), nonempty=True)
-    F_max, beta_max = _limits(limits, motion)
-    x_star = _reference(motion, 0.0)[0]
-    pieces = len(_edges(motion, 0.0, motion.period)) - 1
-    ladder = _ladder(steps, pieces)
-    coarse = _pushed_map(lqr, F_max, beta_max, ladder[0][0], push)
-    orb_c = _orbit(coarse, x_star, h)
-    for j in range(1, len(ladder)):
-        fine = _pushed_map(lqr, F_max, beta_max, ladder[j][0], push)
-        orb_f = _orbit(fine, orb_c.x[0] if orb_c.residual[0] <= NEWTON_TOL else x_star, h)
-        shift = float(np.abs(orb_f.x[0] - orb_c.x[0]).max())
-        if not (shift > ORBIT_SHIFT_TOL) or j == len(ladder) - 1:
-            break
-        coarse, orb_c = fine, orb_f
-    return _decide(orb_c, orb_f, coarse, fine, x_star, starts, periods, h, ladder[j - 1][0], shift,
-                   refine=lambda s: (_pushed_map(lqr, F_max, beta_max, s, push) if s * pieces <= checks.MAX_STEPS
-                                     else None))

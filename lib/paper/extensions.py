@@ -27,12 +27,12 @@ from ..dynamics.verdicts import ORBIT_REGIMES, SIGMAS, held
 from ..dynamics.statistics import batch_grouping
 from ..percussion import circle_lock_radius, percussion_fig5_map
 from ..percussion.claims import paper_circle_of_p
-from ..optimal import margins
-from ..optimal.collocation import ENTRY_PERIODS
+from ..optimal.studies import margins
+from ..optimal.entry import ENTRY_PERIODS
 from ..optimal.motion import verify_motion
-from ..optimal.study import PAPER_CAP
+from ..optimal.studies.study import PAPER_CAP
 from ..model import generalized_force
-from ..optimal.verdict import largest_floquet
+from ..optimal.floquet import largest_floquet
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from ..rotation.fig5 import LOST_FACTOR, fig5_map
 from ..rotation.verdicts import VERDICT_DEFAULTS

@@ -17,15 +17,15 @@ import math
 import numpy as np
 
 from ..machinery.cache import cached
-from ..optimal.collocation import ENTRY_PERIODS
-from ..optimal.study import PAPER_CAP
+from ..optimal.entry import ENTRY_PERIODS
+from ..optimal.studies.study import PAPER_CAP
 from ..params import Body, Gains
 from ..percussion import percussion_fig5_map
 from ..rotation.circle_global import bistable_window
 from ..rotation.fig5 import fig5_map
 from ..machinery.kinds import Number, best_found, upper_bound, within_accuracy
 from ..integrators.smooth import Integration
-from ..optimal.margins import SECOND_EIGHT
+from ..optimal.studies.margins import SECOND_EIGHT
 from ..simulate import OPEN_LOOP_HORIZON
 from ..trajectories import eight
 from . import studies

@@ -19,8 +19,9 @@ from ..limits.attractors import heading_offset_starts, lyapunov_horizons, mirror
 from ..limits.torus import NS_ANGLE_DEG, NS_START_CAP, torus_birth
 from ..limits.confirm import confirmed_limit_verdicts
 from ..machinery.cache import cached
-from ..optimal.compare import limits_study
-from ..optimal.study import entry_rows, mesh_study
+from ..optimal.studies.compare import limits_study
+from ..optimal.studies.entries import entry_rows
+from ..optimal.studies.study import mesh_study
 from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
 from ..percussion.full_loop import full_loop_verdicts, grid_sample
 from ..simulate import OPEN_LOOP_HORIZON, Integration, open_loop_comparison, simulate
@@ -230,7 +231,7 @@ def full_loop_sample(body: Body, gains: Gains) -> tuple[pd.DataFrame, np.ndarray
 
 
 def limits_comparison(body: Body, gains: Gains) -> dict:
-    """Chapter 8's comparison under the limits (:func:`lib.optimal.compare.limits_study`).
+    """Chapter 8's comparison under the limits (:func:`lib.optimal.studies.compare.limits_study`).
 
     Parameters
     ----------
@@ -251,7 +252,7 @@ def _motion_meshes(body: Body, gains: Gains) -> dict:
 
 def motion_meshes(body: Body, gains: Gains) -> dict:
     """Chapter 8's best motions found under the angle limits, refined through the meshes and
-    re-integrated (:func:`lib.optimal.study.mesh_study` of :func:`limits_comparison`'s motions),
+    re-integrated (:func:`lib.optimal.studies.study.mesh_study` of :func:`limits_comparison`'s motions),
     computed once per build.
 
     Parameters
@@ -262,7 +263,7 @@ def motion_meshes(body: Body, gains: Gains) -> dict:
     Returns
     -------
     dict
-        ``chains`` and ``frame``, as :func:`lib.optimal.study.mesh_study` returns them.
+        ``chains`` and ``frame``, as :func:`lib.optimal.studies.study.mesh_study` returns them.
     """
     return cached(_motion_meshes, body, gains)
 
@@ -273,7 +274,7 @@ def _entry_rows(body: Body, gains: Gains) -> pd.DataFrame:
 
 def entries(body: Body, gains: Gains) -> pd.DataFrame:
     """Chapter 8's entries from the paper's start onto the best motions found of
-    :func:`limits_comparison` (:func:`lib.optimal.study.entry_rows`), computed once per build.
+    :func:`limits_comparison` (:func:`lib.optimal.studies.entries.entry_rows`), computed once per build.
 
     Parameters
     ----------

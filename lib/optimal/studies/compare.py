@@ -1,7 +1,7 @@
 """Every law of the book under the paper's limits, beside the best motion and the bound
 (Chapter 8's side-by-side table).
 
-At each limit setting (:data:`lib.optimal.study.SETTINGS`) four controllers run from the paper's
+At each limit setting (:data:`lib.optimal.studies.study.SETTINGS`) four controllers run from the paper's
 start on the eight: the paper's law (23), (25)-(26); the weighted law of Chapter 6 (the exact
 limited allocation, weights (1, 1, 1)); the law for P of Chapter 7 with its anti-windup; and the
 periodic LQR about the best periodic motion found (:mod:`lib.optimal.tracker`). The paper's law
@@ -20,23 +20,24 @@ from typing import Callable
 import numpy as np
 import pandas as pd
 
-from ..allocation import Allocation, Limits, allocate
-from ..closed_loop import ClosedLoop, _weighted_args, limited_weighted_field, reference_of
-from ..control import computed_torque
-from ..dynamics.statistics import block_statistics
-from ..limits.runs import switched_runs
-from ..limits.verdicts import limit_verdicts
-from ..machinery import checks
-from ..machinery.kinds import estimate, exact, lower_bound, upper_bound
-from ..params import PAPER_DZ0, PAPER_Z0, Body, Gains
-from ..percussion.full_loop import _limited_args, limited_field
-from ..percussion.law import ANTI_WINDUP_TIME, closed_loop_rates, error_polynomial
-from ..trajectories import POSITIONS, heading_turns, make
-from .bound import cap_bound
-from .loop import FlowMap, halved_verdict, rows_period_end, run_periods, steady_measures
+from ...allocation import Allocation, Limits, allocate
+from ...closed_loop import ClosedLoop, _weighted_args, limited_weighted_field, reference_of
+from ...control import computed_torque
+from ...dynamics.statistics import block_statistics
+from ...limits.runs import switched_runs
+from ...limits.verdicts import limit_verdicts
+from ...machinery import checks
+from ...machinery.kinds import estimate, exact, lower_bound, upper_bound
+from ...params import PAPER_DZ0, PAPER_Z0, Body, Gains
+from ...percussion.full_loop import _limited_args, limited_field
+from ...percussion.law import ANTI_WINDUP_TIME, closed_loop_rates, error_polynomial
+from ...trajectories import POSITIONS, heading_turns, make
+from ..bound import cap_bound
+from ..loop import FlowMap, halved_verdict, rows_period_end, run_periods, steady_measures
 from .study import PAPER_CAP, SETTINGS, cap_alone_chain, limit_motions, setting_label
-from .tracker import periodic_lqr, track_motion
-from .verdict import basin, floquet_text, motion_verdict
+from ..tracker import periodic_lqr, track_motion
+from ..floquet import floquet_text
+from ..verdict import basin, motion_verdict
 
 __all__ = ["LAWS", "LawLoop", "law_loop", "law_row", "paper_rows", "side_by_side", "WEIGHTS", "THRUST0",
            "LAW_OPTIONS", "LAW_STEPS", "LAW_MAX_STEPS", "PAPER_HORIZON", "PAPER_MEASURED", "RMS_BLOCK",
@@ -277,7 +278,7 @@ def side_by_side(body: Body, gains: Gains, R: float, Theta: float, motions: dict
     R, Theta : float
         The path (m, rad/s).
     motions : dict
-        (angle deg or None, cap or None) -> PeriodicMotion (:func:`lib.optimal.study.limit_motions`).
+        (angle deg or None, cap or None) -> PeriodicMotion (:func:`lib.optimal.studies.study.limit_motions`).
     bounds : dict
         cap (N) -> CapBound (:func:`lib.optimal.bound.cap_bound`) for the settings with a cap.
     settings : sequence of tuple
@@ -319,7 +320,7 @@ def _side_by_side(body, gains, R, Theta, motions, bounds, settings, kind, solved
 
 def limits_study(body: Body, gains: Gains, R: float, Theta: float, *, kind: str = "eight") -> dict:
     """Chapter 8's comparison in one call (cached by the chapter, read by the report): the best
-    motions found at every setting (:func:`lib.optimal.study.limit_motions`), the bound under the
+    motions found at every setting (:func:`lib.optimal.studies.study.limit_motions`), the bound under the
     paper's cap (:func:`lib.optimal.bound.cap_bound`, 256 nodes) and the table
     (:func:`side_by_side`).
 
@@ -330,7 +331,7 @@ def limits_study(body: Body, gains: Gains, R: float, Theta: float, *, kind: str 
         ``table`` (pandas.DataFrame), ``basin_setting`` (the first setting whose controller the
         paper's start does not reach, or the first setting), ``basin`` (its
         :func:`lib.optimal.verdict.basin` frame), ``cap_chain`` (the cap alone's best found on
-        each mesh, :func:`lib.optimal.study.cap_alone_chain`) and ``bound_at_mesh`` (the bound at
+        each mesh, :func:`lib.optimal.studies.study.cap_alone_chain`) and ``bound_at_mesh`` (the bound at
         the collocation's default mesh, as many nodes as it has intervals).
     """
     chain = cap_alone_chain(body, R, Theta, PAPER_CAP, kind=kind)

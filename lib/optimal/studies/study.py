@@ -13,20 +13,17 @@ import math
 import numpy as np
 import pandas as pd
 
-from ..allocation import Limits
-from ..machinery import checks
-from ..machinery.kinds import round_directed
-from ..params import Body
-from .bound import cap_bound, exact_peak_force
-from .collocation import ACCEPTED, entry_motion
-from .motion import START_TIE, PeriodicMotion, periodic_motion, reintegrated
-from .tracker import periodic_lqr
-from .verdict import motion_verdict, offset_starts
+from ...machinery import checks
+from ...machinery.kinds import round_directed
+from ...params import Body
+from ..bound import cap_bound, exact_peak_force
+from ..collocation import ACCEPTED
+from ..motion import START_TIE, PeriodicMotion, periodic_motion, reintegrated
 
 __all__ = ["PAPER_CAP", "CHAPTER_ANGLES_DEG", "SETTINGS", "CAP_REFINED", "MULTISTART_SEED", "MULTISTART_FINE_RANDOM",
            "setting_label", "cap_sweep", "cap_convergence", "limit_motions", "mesh_study", "richardson",
            "multistart", "convergence_table", "motions_table", "multistart_summary", "multistart_optima",
-           "cap_alone_chain", "entry_rows", "entry_table", "entry_basin"]
+           "cap_alone_chain"]
 
 #: the paper's force cap (N), Fig. 4
 PAPER_CAP = 4.0
@@ -35,7 +32,7 @@ CHAPTER_ANGLES_DEG = (90, 60, 45, 30)
 #: the limit settings of Chapter 8's comparison; (angle limit (deg) or None, cap (N) or None)
 SETTINGS = ((None, PAPER_CAP),) + tuple((a, None) for a in CHAPTER_ANGLES_DEG[::-1]) \
     + tuple((a, PAPER_CAP) for a in CHAPTER_ANGLES_DEG[::-1])
-#: the meshes (intervals a period) every motion is refined through after the default one: its inputs
+#: the meshes (intervals a period) every motion is refined through after the default one. Its inputs
 #: are held in the body's frame while the heading swings within an interval, so under a cap its RMS
 #: error falls as h^2 (the cap alone's towards the convex optimum, in the bound's bracket at 320)
 CAP_REFINED = (160, 320)
@@ -392,109 +389,3 @@ def motions_table(frame: pd.DataFrame, rich: pd.DataFrame) -> pd.DataFrame:
                      f"peak F at {nodes} (N)": " / ".join(f"{v:.2f}" for v in f.F_peak),
                      f"best start at {first.nodes}": f"{first.best_start} ({first.starts_at} of {first.starts})"})
     return pd.DataFrame(rows)
-
-
-def entry_rows(body: Body, motions: dict, *, periods: int = 2, steps: int = 2,
-               verdict_periods: int = 8) -> pd.DataFrame:
-    """From the paper's start, an entry (:func:`lib.optimal.collocation.entry_motion`) onto each setting's motion, then
-    the periodic LQR: its loop decided by :func:`lib.optimal.verdict.motion_verdict` from the
-    state the entry's integrated inputs reach (at t = periods T, the motion's phase 0).
-
-    Parameters
-    ----------
-    body : Body
-        The body.
-    motions : dict
-        (angle limit in deg or None, cap in N or None) -> PeriodicMotion.
-    periods : int
-        Periods of each entry.
-    steps, verdict_periods : int
-        :func:`motion_verdict`'s ``steps`` and ``periods``.
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row a setting: setting, angle_deg, cap, regime, reached and settled (the entry's end
-        reaches the orbit on both maps; the two maps agree), entry_rms and entry_max (m),
-        entry_time (s), end_position (m) and end_heading (rad), the entry's end against the motion.
-    """
-    checks.instance("body", body, Body)
-    if not isinstance(motions, dict) or not all(isinstance(m, PeriodicMotion) for m in motions.values()):
-        raise TypeError("motions must be a dict (angle limit, cap) -> PeriodicMotion (limit_motions' result)")
-    rows = []
-    for (angle, cap), m in motions.items():
-        e = entry_motion(body, m, periods=periods)
-        limits = Limits(cap, None if angle is None else math.radians(angle))
-        v = motion_verdict(body, m, limits=limits, lqr=periodic_lqr(body, m), starts=e.end[None],
-                           steps=steps, periods=verdict_periods)
-        rows.append(dict(setting=setting_label(angle, cap), angle_deg=angle, cap=cap, regime=v.regime,
-                         reached=bool(v.reached[0]), settled=bool(v.settled[0]), entry_rms=e.rms_error,
-                         entry_max=e.max_error, entry_time=periods * m.period, end_position=e.end_gap["position"],
-                         end_heading=e.end_gap["heading"]))
-    return pd.DataFrame(rows)
-
-
-def entry_table(rows: pd.DataFrame) -> pd.DataFrame:
-    """:func:`entry_rows` as the page shows it: setting, whether the paper's start reaches the
-    orbit after the entry ("yes", "no", or "undecided" where the verdict's two maps disagree), the
-    entry's RMS and largest distance of C from the path (m, rounded up: values of a motion that
-    exists) and the gap of its integrated end to the motion's state (m, one significant digit, up).
-
-    Parameters
-    ----------
-    rows : pandas.DataFrame
-        The frame of :func:`entry_rows`.
-
-    Returns
-    -------
-    pandas.DataFrame
-        The cells, formatted.
-    """
-    up = lambda v, f: round_directed(float(v), f, "up")      # noqa: E731
-    return pd.DataFrame({
-        "setting": rows.setting,
-        "paper's start reaches": ["yes" if r else ("no" if s else "undecided")
-                                  for r, s in zip(rows.reached, rows.settled)],
-        "entry RMS (m)": [up(v, ".3f") for v in rows.entry_rms],
-        "entry largest (m)": [up(v, ".3f") for v in rows.entry_max],
-        "end gap (m)": [up(v, ".0e") for v in rows.end_position]})
-
-
-def entry_basin(body: Body, motion: PeriodicMotion, limits: Limits, *,
-                heading_offsets=np.linspace(-np.pi, np.pi, 5)[:-1], position_offsets=(-1.0, 0.0, 1.0),
-                periods: int = 2, steps: int = 2, verdict_periods: int = 8) -> pd.DataFrame:
-    """The basin of :func:`lib.optimal.verdict.basin` with the entry: from the paper's start at
-    rest moved by each heading offset (rad) and each offset of x (m), an entry
-    (:func:`lib.optimal.collocation.entry_motion`) onto ``motion``, then its periodic LQR decided
-    from the entry's end by :func:`motion_verdict` on both maps. A start whose entry IPOPT does
-    not solve is recorded as not reached, ``entry`` False.
-
-    Parameters
-    ----------
-    body, motion, limits
-        The body, the motion and its limits.
-    heading_offsets, position_offsets : array_like
-        The grid of offsets (rad, m).
-    periods, steps, verdict_periods : int
-        The entry's periods, and :func:`motion_verdict`'s ``steps`` and ``periods``.
-
-    Returns
-    -------
-    pandas.DataFrame
-        Columns heading_offset (rad), x_offset (m), entry, reached, settled.
-    """
-    checks.instance("body", body, Body)
-    checks.instance("motion", motion, PeriodicMotion)
-    checks.instance("limits", limits, Limits)
-    H, X, S0 = offset_starts(heading_offsets, position_offsets)     # the LQR basin's grid
-    ends, found = [], []
-    for s in S0:
-        try:
-            ends.append(entry_motion(body, motion, s, periods=periods).end), found.append(True)
-        except RuntimeError:
-            ends.append(np.concatenate(motion.state(0.0)) + 1.0), found.append(False)   # far: not reached
-    v = motion_verdict(body, motion, limits=limits, lqr=periodic_lqr(body, motion), starts=np.array(ends),
-                       steps=steps, periods=verdict_periods)
-    found = np.array(found)
-    return pd.DataFrame(dict(heading_offset=H.ravel(), x_offset=X.ravel(), entry=found, reached=v.reached & found,
-                             settled=v.settled | ~found))

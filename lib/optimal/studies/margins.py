@@ -12,10 +12,10 @@
   :func:`lib.optimal.verdict.motion_verdict`, run on the plant (their compiled kernels included),
   apply the nominal gain exactly (to rounding) while the plant moves by its own parameters.
 * A *push*: a constant world-frame force (Fx, Fy) (N) on the body, which no parameter of the
-  model represents; its loop is integrated in numpy (:func:`lib.optimal.verdict.pushed_verdict`,
+  model represents; its loop is integrated in numpy (:func:`lib.optimal.pushed.pushed_verdict`,
   the same two RK4 maps and the same decision as :func:`lib.optimal.verdict.motion_verdict`).
-* The *entry* planned on the model (:func:`lib.optimal.collocation.entry_motion`), run open loop on a
-  wrong or pushed plant or from a disturbed start (:func:`entry_end`), then the tracker: whether the
+* The *entry* planned on the model (:func:`lib.optimal.entry.entry_motion`), run open loop on a
+  wrong or pushed plant or from a disturbed start (:func:`lib.optimal.studies.entries.entry_end`), then the tracker: whether the
   paper's start reaches the orbit (:func:`wrong_model_cases`), and the margin (:func:`entry_margin`).
 * A *second eight*: the bound, the paper's law under the cap and the best motion found with its
   tracker at another point of Fig. 5's grid (:func:`eight_comparison`).
@@ -32,26 +32,27 @@ from dataclasses import replace
 import numpy as np
 import pandas as pd
 
-from ..allocation import Limits
-from ..integrators.batch import RK4, integrate
-from ..machinery import checks
-from ..machinery.cache import cached
-from ..machinery.kinds import upper_bound
-from ..model import config_accel
-from ..params import Body, Gains
-from ..tracking.mismatch import PARAMETERS, model_of
-from ..trajectories import make
-from .bound import cap_bound, exact_peak_force
-from .collocation import Entry, entry_motion
+from ...allocation import Limits
+from ...machinery import checks
+from ...machinery.cache import cached
+from ...machinery.kinds import upper_bound
+from ...params import Body, Gains
+from ...tracking.mismatch import PARAMETERS, model_of
+from ...trajectories import make
+from ..bound import cap_bound, exact_peak_force
+from ..entry import Entry, entry_motion
+from .entries import entry_end
 from .compare import OPTIMAL_PERIODS, OPTIMAL_STEPS, limits_study, paper_rows
-from .loop import steady_measures
-from .motion import periodic_motion
+from ..loop import steady_measures
+from ..motion import periodic_motion
 from .study import PAPER_CAP, setting_label
-from .tracker import DEFAULT_STARTS, RTOL, PeriodicLQR, _edges, _limits, _loop_inputs, _piecewise_ivp, periodic_lqr, track_motion
-from .verdict import _pushed_loop, floquet_text, motion_verdict, pushed_verdict
+from ..tracker import DEFAULT_STARTS, RTOL, PeriodicLQR, _edges, _limits, _loop_inputs, _piecewise_ivp, periodic_lqr, track_motion
+from ..floquet import floquet_text
+from ..pushed import _pushed_loop, pushed_verdict
+from ..verdict import motion_verdict
 
-__all__ = ["MARGIN", "MARGIN_SETTINGS", "WRONG_DELTA", "PUSH", "SECOND_EIGHT", "ENTRY_STEPS", "ENTRY_FIRST",
-           "ENTRY_DOUBLINGS", "ENTRY_HALVINGS", "plant_lqr", "tracked_case", "entry_end", "entry_margin",
+__all__ = ["MARGIN", "MARGIN_SETTINGS", "WRONG_DELTA", "PUSH", "SECOND_EIGHT", "ENTRY_FIRST",
+           "ENTRY_DOUBLINGS", "ENTRY_HALVINGS", "plant_lqr", "tracked_case", "entry_margin",
            "margin_cases", "wrong_model_cases", "eight_comparison", "issue_study", "margin_table",
            "wrong_model_table", "entry_margin_table"]
 
@@ -63,9 +64,6 @@ MARGIN_SETTINGS = ((None, PAPER_CAP), (30, PAPER_CAP))
 WRONG_DELTA = 0.1
 #: the disturbance, a constant world-frame push (N) along x
 PUSH = (0.2, 0.0)
-#: RK4 steps on each input piece of an entry run open loop (:func:`entry_end`): its end moves by
-#: about 1e-6 against DOP853 at rtol 1e-10 (14 times less a halving), a thousandth of the reach tolerance
-ENTRY_STEPS = 4
 #: the entry's disturbances (:func:`entry_margin`), each with its first level (heading in rad, x and y
 #: in m, m relative), and the search's doublings and halvings
 ENTRY_FIRST, ENTRY_DOUBLINGS, ENTRY_HALVINGS = {"heading": 0.05, "x": 0.05, "y": 0.05, "m": 0.025}, 4, 2
@@ -128,8 +126,8 @@ def tracked_case(model: Body, motion, limits: Limits, *, plant: Body | None = No
     """The tracker of ``motion``, planned and gained on ``model``, run on ``plant`` (default the
     model) with an optional constant world-frame ``push`` (N), decided by the book's procedure
     (:func:`lib.optimal.verdict.motion_verdict` on :func:`plant_lqr`, or
-    :func:`lib.optimal.verdict.pushed_verdict`) at the chapter's steps and periods
-    (:data:`lib.optimal.compare.OPTIMAL_STEPS`, :data:`lib.optimal.compare.OPTIMAL_PERIODS`) and
+    :func:`lib.optimal.pushed.pushed_verdict`) at the chapter's steps and periods
+    (:data:`lib.optimal.studies.compare.OPTIMAL_STEPS`, :data:`lib.optimal.studies.compare.OPTIMAL_PERIODS`) and
     measured over one period of its orbit.
 
     Parameters
@@ -177,38 +175,10 @@ def tracked_case(model: Body, motion, limits: Limits, *, plant: Body | None = No
                 settled=int(v.settled[:n].sum()), **extra, **meas)
 
 
-def entry_end(plant: Body, motion, entry: Entry, start=None, *, push=None) -> np.ndarray:
-    """Where the inputs of ``entry`` (planned on the model, :func:`lib.optimal.collocation.entry_motion`),
-    applied open loop, bring ``plant`` from ``start`` ((6,) or (S, 6), default the paper's start)
-    under an optional constant world-frame ``push`` (Fx, Fy) (N). RK4, :data:`ENTRY_STEPS` steps
-    an input piece.
-
-    Returns
-    -------
-    numpy.ndarray
-        The states at t = ``entry.periods`` T, the motion's phase 0, shaped as ``start``, the
-        heading brought back by the plan's turns as in :attr:`lib.optimal.collocation.Entry.end`.
-    """
-    checks.instance("plant", plant, Body)
-    checks.instance("entry", entry, Entry, "lib.optimal.collocation.Entry")
-    x0 = checks.array("start", DEFAULT_STARTS[0] if start is None else start)
-    X = checks.array("start", np.atleast_2d(x0), shape=(None, 6))
-    px, py = (0.0, 0.0) if push is None else checks.array("push", push, shape=(2,))
-    h, pushed = motion.period / entry.nodes, np.array([px / plant.m, py / plant.m, 0.0])
-    turns = 2 * np.pi * (np.round((X[:, 2] - motion.state(0.0)[0][2]) / (2 * np.pi)) + motion.turns * entry.periods)
-
-    def rates(F, beta):
-        return lambda t, Y: np.concatenate([Y[:, 3:], config_accel(plant, Y[:, :3], Y[:, 3:], F, beta) + pushed], -1)
-    for k, (F, beta) in enumerate(zip(entry.F, entry.beta)):
-        X = integrate(rates(F, beta), X, k * h, (k + 1) * h, h / ENTRY_STEPS, RK4)[1][-1]
-    X[:, 2] -= turns
-    return X.reshape(x0.shape)
-
-
 def entry_margin(body: Body, motion, limits: Limits, *, first=ENTRY_FIRST, doublings: int = ENTRY_DOUBLINGS,
                  halvings: int = ENTRY_HALVINGS) -> pd.DataFrame:
     """How far the paper's start may be disturbed while the entry planned from it on ``body``
-    (:func:`lib.optimal.collocation.entry_motion`), run open loop (:func:`entry_end`), and then the
+    (:func:`lib.optimal.entry.entry_motion`), run open loop (:func:`lib.optimal.studies.entries.entry_end`), and then the
     periodic LQR still reach the orbit, as :func:`lib.optimal.verdict.motion_verdict` decides
     (both maps, the chapter's steps and periods). Each quantity of ``first`` (quantity -> first
     level: "heading" (rad), "x", "y" (m), the start moved; "m" (relative), the plant
@@ -311,7 +281,7 @@ def wrong_model_cases(body: Body, plans: dict, *, delta: float = WRONG_DELTA, pu
                       push_at=MARGIN_SETTINGS[:1], parameters=PARAMETERS, entry: bool = True) -> pd.DataFrame:
     """Each plan's tracker on a plant with one parameter off by +-``delta``, and under ``push``;
     with ``entry``, the paper's start brought by the plan's entry (planned on the model,
-    :func:`lib.optimal.collocation.entry_motion`) run open loop on the plant (:func:`entry_end`),
+    :func:`lib.optimal.entry.entry_motion`) run open loop on the plant (:func:`lib.optimal.studies.entries.entry_end`),
     and decided in the same verdict as an eighth start.
 
     Parameters
@@ -359,7 +329,7 @@ def eight_comparison(body: Body, gains: Gains, R: float, Theta: float, *, cap: f
                      nodes: int = 80) -> dict:
     """Chapter 8's headline comparison on the eight (R, Theta) under the cap alone: the
     certified bound (:func:`lib.optimal.bound.cap_bound`, 256 nodes), the paper's law
-    (:func:`lib.optimal.compare.paper_rows`, Chapter 4's procedure from the paper's start, as
+    (:func:`lib.optimal.studies.compare.paper_rows`, Chapter 4's procedure from the paper's start, as
     the side-by-side table's row), and the best motion found
     (:func:`lib.optimal.motion.periodic_motion` from every start, the convex one included, at
     ``nodes`` intervals) with its tracker (:func:`tracked_case`). Refuses an eight whose exact
@@ -398,9 +368,9 @@ def eight_comparison(body: Body, gains: Gains, R: float, Theta: float, *, cap: f
 
 def issue_study(body: Body, gains: Gains, R: float, Theta: float, *, fraction: float = MARGIN) -> dict:
     """Chapter 8's margin, wrong-model and second-eight cases in one call (the chapter caches
-    it; the unmargined motions are those of :func:`lib.optimal.compare.limits_study`, read
+    it; the unmargined motions are those of :func:`lib.optimal.studies.compare.limits_study`, read
     through the cache): at each of :data:`MARGIN_SETTINGS` the best motion found at 80
-    intervals (the cap alone's first mesh, :func:`lib.optimal.study.cap_alone_chain`) and its
+    intervals (the cap alone's first mesh, :func:`lib.optimal.studies.study.cap_alone_chain`) and its
     margined plan (:func:`margin_cases`), each tracked on the wrong plants and under
     :data:`PUSH` (:func:`wrong_model_cases`), and the comparison on :data:`SECOND_EIGHT`
     (:func:`eight_comparison`).
@@ -463,7 +433,7 @@ def margin_table(table: pd.DataFrame) -> pd.DataFrame:
 
 def wrong_model_table(frame: pd.DataFrame, setting: str, margin: bool) -> pd.DataFrame:
     """:func:`wrong_model_cases`' rows (a frame) at one ``setting`` (its label,
-    :func:`lib.optimal.study.setting_label`) and ``margin`` (bool) as the page shows them, one row
+    :func:`lib.optimal.studies.study.setting_label`) and ``margin`` (bool) as the page shows them, one row
     a case: the plant's parameter, its change, the tracker's cells and, where the frame has them,
     whether the paper's start reaches the orbit after the entry ("yes", "no", or "undecided"
     where the verdict's two maps disagree).

@@ -39,15 +39,15 @@ import math
 import numpy as np
 import pandas as pd
 
-from ..angles import wrap_angle
-from ..machinery import checks
-from ..params import Body
-from ..percussion.engine import HeadingEngine, coefficients
-from ..percussion.point import centre_of_percussion, lateral_drag_speed
-from ..percussion.sweep import heading_sweep
-from ..rotation.verdicts import FIG5_GRID
-from ..trajectories import POSITIONS
-from .bound import exact_peak_force
+from ...angles import wrap_angle
+from ...machinery import checks
+from ...params import Body
+from ...percussion.engine import HeadingEngine, coefficients
+from ...percussion.point import centre_of_percussion, lateral_drag_speed
+from ...percussion.sweep import heading_sweep
+from ...rotation.verdicts import FIG5_GRID
+from ...trajectories import POSITIONS
+from ..bound import exact_peak_force
 
 __all__ = ["DENSE_STEPS", "CANDIDATES", "GOLDEN_ITERATIONS", "RK4_SUBSTEPS", "exact_force_map",
            "exact_force_maps"]
