@@ -38,7 +38,7 @@ __all__ = ["TESTS", "BORDERLINE_STARTS", "PER_SIDE", "WIDTH", "t_threshold", "ho
 TESTS = ("lost", "chaotic")
 #: independent starts per borderline point (a ratio's interval about 0.85 to 1.2 times it)
 BORDERLINE_STARTS = 64
-#: points taken on each side of each line: the nearest to it
+#: points taken on each side of each line, the nearest to it
 PER_SIDE = 2
 #: a verdict is borderline when its statistic lies within this many standard errors of the line
 WIDTH = 1.0

@@ -30,7 +30,7 @@ ENTRY_PERIODS, ENTRY_NODES = 2, 80
 
 @lru_cache(maxsize=2)
 def entry_transcription(body: Body, nodes: int, degree: int) -> Transcription:
-    """The NLP of an entry manoeuvre: :func:`transcription`'s, but open: from X_0 (fixed by the
+    """The NLP of an entry manoeuvre: :func:`lib.optimal.collocation.transcription`'s, but open: from X_0 (fixed by the
     caller's bounds) to X_nodes = a target given as a parameter. Parameters: h (s), the target
     (6: m, m, rad, m/s, m/s, rad/s), then C_d at the collocation points.
 

@@ -38,7 +38,7 @@ def floquet_estimate(value: float, error: float) -> Number:
     Parameters
     ----------
     value, error : float
-        |mu_1| and its stated error (:class:`MotionVerdict`), finite, >= 0.
+        |mu_1| and its stated error (:class:`lib.optimal.verdict.MotionVerdict`), finite, >= 0.
 
     Returns
     -------

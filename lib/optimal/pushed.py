@@ -64,20 +64,20 @@ def _pushed_map(lqr: PeriodicLQR, F_max, beta_max, steps: int, push):
 
 def pushed_verdict(body: Body, motion, push, *, limits: Limits | None = None, lqr: PeriodicLQR | None = None,
                    starts=None, periods: int = 20, steps: int = 8, h: float = 1e-5) -> MotionVerdict:
-    """:func:`motion_verdict` of the loop with a constant world-frame force ``push`` = (Fx, Fy)
+    """:func:`lib.optimal.verdict.motion_verdict` of the loop with a constant world-frame force ``push`` = (Fx, Fy)
     (N) on ``body``: Newton on two RK4 maps (``steps`` and twice as many steps an input piece,
-    doubled while the orbit moves by more than :data:`ORBIT_SHIFT_TOL`), the multipliers, and the
+    doubled while the orbit moves by more than :data:`lib.optimal.verdict.ORBIT_SHIFT_TOL`), the multipliers, and the
     starts' reach test, by the same decision. Integrated in numpy (no compiled kernel takes a
     push): about a second of CPU a verdict at Chapter 8's steps.
 
     Parameters
     ----------
     body, motion, limits, lqr
-        As in :func:`motion_verdict` (``lqr`` may be a :func:`lib.optimal.studies.margins.plant_lqr`).
+        As in :func:`lib.optimal.verdict.motion_verdict` (``lqr`` may be a :func:`lib.optimal.studies.margins.plant_lqr`).
     push : array_like
         (Fx, Fy) (N), world frame.
     starts, periods, steps, h
-        As in :func:`motion_verdict`.
+        As in :func:`lib.optimal.verdict.motion_verdict`.
 
     Returns
     -------

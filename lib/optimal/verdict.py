@@ -93,7 +93,7 @@ class MotionVerdict:
     :data:`lib.optimal.tracker.RTOL` and :data:`FINE_RTOL`); ``orbit_shift`` how far the orbit
     moved between the two (max-norm, state units), ``multiplier_spread`` the range of |mu_1| over
     the central and one-sided difference Jacobians of step h and h / 2, ``multiplier_error`` the
-    stated error of |mu_1| (the module's docstring; :func:`floquet_estimate`). Per start (S,):
+    stated error of |mu_1| (the module's docstring; :func:`lib.optimal.floquet.floquet_estimate`). Per start (S,):
     ``reached`` (on both maps), ``settled``
     (the same fate on both) and ``distance``, the finer map's final section distance to the orbit
     point (max-norm, heading unwrapped; NaN when the starts were not run), after ``periods``

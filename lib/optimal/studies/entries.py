@@ -41,7 +41,7 @@ def entry_end(plant: Body, motion, entry: Entry, start=None, *, push=None) -> np
     -------
     numpy.ndarray
         The states at t = ``entry.periods`` T, the motion's phase 0, shaped as ``start``, the
-        heading brought back by the plan's turns as in :attr:`lib.optimal.entry.Entry.end`.
+        heading brought back by the plan's turns as in ``end`` of :class:`lib.optimal.entry.Entry`.
     """
     checks.instance("plant", plant, Body)
     checks.instance("entry", entry, Entry, "lib.optimal.entry.Entry")
