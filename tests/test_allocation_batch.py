@@ -154,3 +154,41 @@ def test_chapter_6_limits_comparison_is_converged_in_the_step_and_its_directions
             assert r.loc[(s, "exact"), "pos_rms"] > r.loc[(s, "projection"), "pos_rms"] + 0.01
     with pytest.raises(ValueError, match="periods must be an integer"):
         weighting.limits_comparison(Body(), Gains(), "eight", 2.0, 1.0, (1, 1, 1), sets, periods=1)
+
+
+def _verdict_frame(held_flags, why=None):
+    """Verdict rows, held where asked; a row that is not held fails for the reason given ("lost",
+    "position" or "chaotic")."""
+    import pandas as pd
+    why = why or ["lost"] * len(held_flags)
+    rows = [dict(regime="periodic" if h or w != "chaotic" else "chaotic", lost=not h and w == "lost",
+                 tracked=h or w != "position") for h, w in zip(held_flags, why)]
+    return pd.DataFrame(rows)
+
+
+def test_stability_boundary_is_the_first_weight_lost_not_the_last():
+    # issue 59's surviving mutant: bad[0] -> bad[-1] went unseen with a single non-held row
+    f = _verdict_frame([True, True, False, True, False], ["", "", "lost", "", "position"])
+    b = weighting.stability_boundary([0.1, 0.2, 0.4, 0.8, 1.6], f)
+    assert (b["last_held"], b["first_lost"], b["changes"]) == (0.2, 0.4, 3)
+    assert b["verdict"] == "periodic, heading lost"
+
+
+def test_refine_boundary_narrows_the_bracket_around_the_true_boundary(monkeypatch):
+    # a loop held exactly below w* = 0.3: one round of n new weights, even in log between the last
+    # held and the first lost, brackets w* (n + 1) times tighter in log
+    from lib.weighting import comparison
+    w_star, n = 0.3, 7
+
+    def fake_runs(body, gains, runs, **options):
+        w = runs["fine"]["weights"][:, 2]
+        return {"fine": _verdict_frame(list(w < w_star))}
+    monkeypatch.setattr(comparison, "verdict_runs", fake_runs)
+    grid = np.array([0.1, 0.2, 0.4, 0.8])
+    b, w_all, frame = comparison.refine_boundary(Body(), Gains(), {"kind": "eight", "R": 2.0, "Theta": 0.5},
+                                                 grid, _verdict_frame(list(grid < w_star)), n=n)
+    assert b["last_held"] < w_star <= b["first_lost"]
+    assert np.log(b["first_lost"] / b["last_held"]) == pytest.approx(np.log(0.4 / 0.2) / (n + 1), rel=1e-12)
+    assert w_all.size == grid.size + n and np.all(np.diff(w_all) > 0) and len(frame) == w_all.size
+    with pytest.raises(ValueError, match="no boundary"):
+        comparison.refine_boundary(Body(), Gains(), {}, grid, _verdict_frame([True] * 4))

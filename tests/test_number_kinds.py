@@ -42,6 +42,8 @@ def test_the_certified_bound_of_the_issue_is_written_below_itself():
     assert kinds.lower_bound(0.10769, ".3f").text() == "0.107"
     assert kinds.lower_bound(0.10769, ".4f").text() == "0.1076"
     assert kinds.best_found(0.10776, ".4f").text() == "0.1078"
+    # where rounding up and to nearest differ (issue 59's surviving mutant): a motion found is written up
+    assert kinds.best_found(0.10771, ".4f").text() == "0.1078" and kinds.exact(0.10771, ".4f").text() == "0.1077"
     assert kinds.upper_bound(0.10770, ".3g").text() == "0.108"
     assert kinds.at_most(0.10761, ".3f").text() == "0.108" and kinds.at_least(0.10769, ".3f").text() == "0.107"
     assert kinds.exact(0.10769, ".3f").text() == "0.108"
