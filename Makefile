@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: book test test-portable chapter pdf benchmark book-times clean mutation
+.PHONY: book test test-portable chapter pdf lab benchmark book-times clean mutation
 
 $(STAMP): requirements.txt pyproject.toml
 	@echo "Installing .venv from requirements.txt and pyproject.toml (a few minutes the first time)..."
@@ -38,7 +38,8 @@ chapter: $(STAMP)
 	PYTHONWARNINGS=default $(BIN)/python tools/preexecute.py --keep-cache --jobs 1 $(CH)
 	$(BIN)/jupyter-book build --all -n --keep-going .
 
-# The whole book as one PDF, _build/pdf/book.pdf (tools/pdf.py): the single-page HTML build,
+# The book as one PDF, _build/pdf/book.pdf, and the library reference apart, _build/pdf/reference.pdf
+# (tools/pdf.py): the single-page HTML build,
 # which reads every page's outputs from the execution cache (`make book` fills it first when
 # it is missing), printed by headless Chromium once MathJax has typeset the math, each
 # interactive figure as a static image. Needs Debian's chromium (.ci/run installs it).
@@ -86,6 +87,13 @@ test-portable: $(STAMP)
 	$(PORTABLE_ENV) $(MAKE) --no-print-directory book > _build/book-portable.out 2>&1 || \
 	  { tail -n 60 _build/book-portable.out; echo "The book failed under the portable arithmetic (_build/book-portable.out)"; exit 1; }
 	$(PORTABLE_ENV) $(BIN)/python -m pytest -m "book and not packaging" -p no:cacheprovider
+
+# JupyterLab on the book's folder, on the loopback address: a chapter (chapters/*.md, a MyST text
+# notebook) opens as a notebook through jupytext, and runs in the project's kernel (.venv's python3).
+# Its outputs stay in the browser, never in the .md (a cell's outputs are not saved to the text).
+lab: $(STAMP)
+	$(BIN)/jupyter lab --ServerApp.ip=127.0.0.1 --ServerApp.allow_root=True \
+	  --LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate --ServerApp.root_dir=$(CURDIR) chapters
 
 benchmark: $(STAMP)
 	$(BIN)/python benchmarks/bench_switched.py
