@@ -1,6 +1,8 @@
 """``make pdf``'s route, run as CI runs it: the single-page HTML build read from the execution
-cache that the book's build filled, printed by headless Chromium (``tools/pdf.py``). The PDF
-holds every page of the table of contents in order, the front page's findings with their glued
+cache that the book's build filled, printed by headless Chromium (``tools/pdf.py``) as two files,
+the book as an article (under 130 A4 pages) and the library reference apart. The book's PDF
+holds every page of the table of contents but the reference's in order, and the reference's PDF
+those, the front page's findings with their glued
 numbers, typeset math (no TeX source left), every figure of the book as an image, the
 interactive ones as static PNGs, and nothing cut off at the right edge.
 
@@ -23,19 +25,20 @@ pytestmark = pytest.mark.browser
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tools"))
-from pdf import CHROMIUM, OUT, SINGLE, root_page  # noqa: E402  (tools/ is not a package)
+from pdf import CHROMIUM, OUT, REFERENCE_NAME, REFERENCE_PAGE, SINGLE, root_page  # noqa: E402  (tools/ is not a package)
 from preexecute import toc_pages  # noqa: E402
 
 GLUE_ROLE = re.compile(r"\{glue(?::text)?\}`([^`]+)`")
-#: the book printed on 269 A4 pages (2026-11-28), every page of the table of contents starting
-#: a printed page; fewer than this means whole parts of it are missing
-MIN_PAGES = 150
+#: the book as an article, the library reference apart: at most MAX_PAGES A4 pages (issue 59: it
+#: was 297 with the reference, 106 without), at least MIN_PAGES (fewer means whole parts missing);
+#: the reference at least MIN_REFERENCE_PAGES (191 when it was printed with the book)
+MIN_PAGES, MAX_PAGES, MIN_REFERENCE_PAGES = 80, 130, 100
 
 
-def read_pdf(out: Path) -> dict:
+def read_pdf(out: Path, record: str = "figures.json") -> dict:
     """What poppler reads in the PDF ``out``: its page count, its text (``pdftotext -layout``,
     and with its whitespace collapsed), its images (``pdfimages -list`` rows), and what the
-    printed HTML held (``figures.json`` beside it, written by ``tools/pdf.py``)."""
+    printed HTML held (``record`` beside it, written by ``tools/pdf.py``)."""
     info = subprocess.run(["pdfinfo", str(out)], capture_output=True, text=True, check=True).stdout
     text = subprocess.run(["pdftotext", "-layout", str(out), "-"], capture_output=True, text=True,
                           check=True).stdout
@@ -43,7 +46,7 @@ def read_pdf(out: Path) -> dict:
     rows = [line.split() for line in listing.splitlines()[2:] if line.strip()]
     return {"pages": int(re.search(r"^Pages:\s+(\d+)", info, re.M).group(1)), "text": text,
             "flat": " ".join(text.split()), "images": [row for row in rows if row[2] == "image"],
-            "held": json.loads((out.parent / "figures.json").read_text())}
+            "held": json.loads((out.parent / record).read_text())}
 
 
 @pytest.fixture(scope="module")
@@ -62,6 +65,12 @@ def book_pdf(built_book) -> dict:
     return read_pdf(OUT)
 
 
+@pytest.fixture(scope="module")
+def reference_pdf(book_pdf) -> dict:
+    """The library reference's PDF, printed beside the book's by the same run."""
+    return read_pdf(OUT.with_name(REFERENCE_NAME), "reference.json")
+
+
 def _title(page: str) -> str:
     """The page's first heading, as its Markdown source writes it."""
     src = (ROOT / f"{page}.md").read_text()
@@ -73,24 +82,38 @@ def _plain(title: str) -> str:
     return " ".join(re.sub(r"[*_`]", "", title).split())
 
 
-def test_pdf_has_a_sane_number_of_pages(book_pdf):
-    assert book_pdf["pages"] >= MIN_PAGES, book_pdf["pages"]
+def _is_reference(page: str) -> bool:
+    return page == REFERENCE_PAGE or page.startswith(REFERENCE_PAGE + "/")
 
 
-def test_every_page_of_the_table_of_contents_starts_a_printed_page_in_order(book_pdf):
-    """Each page of ``_toc.yml`` after the front page (every chapter, the report, Methods, the
-    errata, the bibliography and the library reference) opens a printed page with its title,
-    in the order of the table of contents (the contents list on the first page does not count:
-    it opens no page)."""
-    pages = book_pdf["text"].split("\f")
-    # a page's first three lines of text: a long title wraps
-    heads = [" ".join(" ".join([ln for ln in pg.splitlines() if ln.strip()][:3]).split()) for pg in pages]
-    at = 0
-    for page in toc_pages(ROOT)[1:]:
+def test_the_book_prints_as_an_article_and_the_reference_apart(book_pdf, reference_pdf):
+    assert MIN_PAGES <= book_pdf["pages"] <= MAX_PAGES, book_pdf["pages"]
+    assert reference_pdf["pages"] >= MIN_REFERENCE_PAGES, reference_pdf["pages"]
+    pages = toc_pages(ROOT)
+    assert book_pdf["held"]["pages"] == sum(not _is_reference(p) for p in pages)
+    assert reference_pdf["held"]["pages"] == sum(_is_reference(p) for p in pages) >= 5
+
+
+def _opens_in_order(pdf: dict, pages: list[str], first: int) -> None:
+    """Each of ``pages`` opens a printed page of ``pdf`` with its title, in order, after page ``first``."""
+    heads = [" ".join(" ".join([ln for ln in pg.splitlines() if ln.strip()][:3]).split())
+             for pg in pdf["text"].split("\f")]                     # a long title wraps: three lines
+    at = first
+    for page in pages:
         title = _plain(_title(page))
         found = next((i for i in range(at + 1, len(heads)) if title in heads[i]), None)
         assert found is not None, f"{page}: no printed page after page {at + 1} opens with {title!r}"
         at = found
+
+
+def test_every_page_of_the_table_of_contents_starts_a_printed_page_in_order(book_pdf, reference_pdf):
+    """Each page of ``_toc.yml`` after the front page (every chapter, the report, Methods, the
+    errata and the bibliography) opens a printed page of the book's PDF with its title, in the
+    order of the table of contents (the contents list on the first page does not count: it opens
+    no page); the reference's pages open pages of the reference's PDF, in order."""
+    pages = toc_pages(ROOT)
+    _opens_in_order(book_pdf, [p for p in pages[1:] if not _is_reference(p)], 0)
+    _opens_in_order(reference_pdf, [p for p in pages if _is_reference(p)], -1)
 
 
 def _glued(doc: str) -> list[str]:

@@ -15,10 +15,13 @@ Two steps:
    PNG of itself (``Plotly.toImage``: the static image a printed page needs, and one that
    ``pdfimages`` counts), and prints the page to A4 with page numbers.
 
-Output: ``_build/pdf/book.pdf`` (``--out``), and beside it ``figures.json``, what the printed
-HTML held (images, interactive figures, typeset formulas and any math left untypeset), which
-``tests/test_pdf.py`` compares with the PDF. ``--no-build`` prints the existing
-``_build/singlehtml`` again; ``--root`` names another copy of the book.
+Output, two files: ``_build/pdf/book.pdf`` (``--out``), the book as an article to read, cite or
+review (the front page, the report, Methods, every chapter, the errata and the bibliography), and
+beside it ``reference.pdf``, the library reference (its pages, which the HTML also holds, cut from
+the article: they were two thirds of its pages). Beside each, ``figures.json`` and
+``reference.json``: what the printed HTML held (images, interactive figures, typeset formulas and
+any math left untypeset), which ``tests/test_pdf.py`` compares with the PDF. ``--no-build``
+prints the existing ``_build/singlehtml`` again; ``--root`` names another copy of the book.
 """
 
 from __future__ import annotations
@@ -39,7 +42,11 @@ ROOT = Path(__file__).resolve().parents[1]
 #: the single-page build and the PDF, under a book's folder
 SINGLE_DIR = Path("_build") / "singlehtml"
 OUT_FILE = Path("_build") / "pdf" / "book.pdf"
+#: the library reference's PDF, beside the book's
+REFERENCE_NAME = "reference.pdf"
 SINGLE, OUT = ROOT / SINGLE_DIR, ROOT / OUT_FILE
+#: the table of contents' page whose pages (it and its sections) make the reference
+REFERENCE_PAGE = "reference"
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 #: the browser test's launch flags (tests/test_browser.py): no sandbox (root), no GPU, nothing
 #: that reaches for a network
@@ -75,6 +82,22 @@ STATIC_PLOTLY = """async () => {
   return divs.length;
 }"""
 
+#: the part of the single page to print: "book" drops the reference's pages (a ``document-``
+#: anchor of the reference page or of one below it, and the section after it), "reference" keeps
+#: them alone. Returns how many pages were kept.
+SELECT_PART = """([part, ref]) => {
+  const isRef = id => id === 'document-' + ref || id.startsWith('document-' + ref + '/');
+  const anchors = Array.from(document.querySelectorAll('span[id^="document-"]'));
+  const refs = anchors.filter(a => isRef(a.id));
+  if (part === 'book') {
+    for (const a of refs) { const s = a.nextElementSibling; if (s) s.remove(); a.remove(); }
+    return anchors.length - refs.length;
+  }
+  const main = document.querySelector('main .bd-article') || document.querySelector('main') || document.body;
+  const top = refs.find(a => a.id === 'document-' + ref);
+  main.replaceChildren(top, top.nextElementSibling);
+  return refs.length;
+}"""
 #: what the printed page holds: every image in the book's content (the matplotlib figures, the
 #: animations' first frames, the interactive figures' PNGs) and the figure environments; the math
 #: nodes of Sphinx (``.math``) and those MathJax left untypeset (no ``mjx-container`` inside)
@@ -209,9 +232,10 @@ def _serve(folder: Path):
         httpd.shutdown()
 
 
-def print_pdf(html_dir: Path, out: Path, page_name: str = "intro") -> dict:
+def print_pdf(html_dir: Path, out: Path, page_name: str = "intro", part: str = "book") -> dict:
     """Print ``html_dir/<page_name>.html`` to ``out`` in headless Chromium, once MathJax has
-    typeset and every image loaded, each interactive figure replaced by a PNG of itself.
+    typeset and every image loaded, each interactive figure replaced by a PNG of itself; ``part``
+    ``"book"`` without the library reference's pages, ``"reference"`` those alone.
 
     Parameters
     ----------
@@ -221,14 +245,18 @@ def print_pdf(html_dir: Path, out: Path, page_name: str = "intro") -> dict:
         The PDF to write.
     page_name : str
         The book's root page (:func:`root_page`), which holds the whole book.
+    part : str
+        ``"book"`` or ``"reference"``.
 
     Returns
     -------
     dict
         What the printed page held: ``images``, ``figures``, ``interactive`` (replaced by PNGs),
         ``math`` (typeset formulas), ``broken`` (images that did not load), ``requests`` (URLs
-        asked for off the loopback address, which must be none).
+        asked for off the loopback address, which must be none), ``pages`` (the book's pages kept).
     """
+    if part not in ("book", "reference"):
+        raise ValueError(f"part must be 'book' or 'reference', got {part!r}")
     from playwright.sync_api import sync_playwright
 
     if not Path(CHROMIUM).exists():
@@ -248,6 +276,7 @@ def print_pdf(html_dir: Path, out: Path, page_name: str = "intro") -> dict:
                                timeout=120_000)
         page.evaluate("() => MathJax.startup.promise")
         page.wait_for_function("() => Array.from(document.images).every(i => i.complete)", timeout=120_000)
+        kept = page.evaluate(SELECT_PART, [part, REFERENCE_PAGE])
         interactive = page.evaluate(STATIC_PLOTLY)
         page.add_style_tag(content=PRINT_CSS)
         page.emulate_media(media="print")
@@ -256,7 +285,7 @@ def print_pdf(html_dir: Path, out: Path, page_name: str = "intro") -> dict:
         page.pdf(path=str(out), format="A4", print_background=True, margin=MARGIN, scale=SCALE,
                  display_header_footer=True, header_template="<span></span>", footer_template=FOOTER)
         browser.close()
-    return {**held, "interactive": interactive, "requests": outside}
+    return {**held, "interactive": interactive, "requests": outside, "pages": kept}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -276,13 +305,16 @@ def main(argv: list[str] | None = None) -> int:
             print(log.read_text()[-4000:])
             print(f"the single-page build failed (exit {rc}); see {log}", file=sys.stderr)
             return 1
-    print(f"Printing {root / SINGLE_DIR / root_page(root)}.html in headless Chromium", flush=True)
-    held = print_pdf(root / SINGLE_DIR, out, root_page(root))
-    (out.parent / "figures.json").write_text(json.dumps(held, indent=1) + "\n")
-    problems = ([f"images that did not load: {held['broken']}"] if held["broken"] else []) + \
-               ([f"requests off the loopback address: {held['requests']}"] if held["requests"] else [])
-    print(f"{out}: {held['images']} images ({held['interactive']} interactive figures as PNG), "
-          f"{held['math']} formulas, {time.perf_counter() - tic:.0f} s", flush=True)
+    problems = []
+    for part, pdf, record in (("book", out, "figures.json"), ("reference", out.with_name(REFERENCE_NAME),
+                                                              "reference.json")):
+        print(f"Printing the {part} of {root / SINGLE_DIR / root_page(root)}.html in headless Chromium", flush=True)
+        held = print_pdf(root / SINGLE_DIR, pdf, root_page(root), part)
+        (out.parent / record).write_text(json.dumps(held, indent=1) + "\n")
+        problems += ([f"{part}: images that did not load: {held['broken']}"] if held["broken"] else []) + \
+                    ([f"{part}: requests off the loopback address: {held['requests']}"] if held["requests"] else [])
+        print(f"{pdf}: {held['pages']} pages of the book, {held['images']} images ({held['interactive']} "
+              f"interactive figures as PNG), {held['math']} formulas, {time.perf_counter() - tic:.0f} s", flush=True)
     for problem in problems:
         print("ERROR: " + problem, file=sys.stderr)
     return 1 if problems else 0
