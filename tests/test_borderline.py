@@ -35,15 +35,15 @@ def test_sign_test_counts_the_ratios_above_and_is_the_binomial_tail():
     got = bl.sign_test(ratios)
     assert (got["above"], got["n"]) == (4, 5)
     # P(X >= 4), X binomial (5, 1/2): (5 + 1) / 32, in closed form and by scipy
-    assert got["pvalue"] == pytest.approx(6 / 32, rel=1e-12)
-    assert got["pvalue"] == pytest.approx(stats.binomtest(4, 5, 0.5, alternative="greater").pvalue, rel=1e-12)
+    assert got["pvalue"] == pytest.approx(6 / 32, rel=1e-12)  # exact: a binomial tail's closed form
+    assert got["pvalue"] == pytest.approx(stats.binomtest(4, 5, 0.5, alternative="greater").pvalue, rel=1e-12)  # exact: scipy's binomtest on the same counts
     two = bl.sign_test(ratios, alternative="two-sided")
-    assert two["pvalue"] == pytest.approx(stats.binomtest(4, 5, 0.5).pvalue, rel=1e-12)
+    assert two["pvalue"] == pytest.approx(stats.binomtest(4, 5, 0.5).pvalue, rel=1e-12)  # exact: scipy's binomtest on the same counts
 
 
 def test_nine_ratios_of_nine_above_one_is_a_lean_at_p_one_in_512():
     got = bl.sign_test(np.linspace(1.02, 1.10, 9))
-    assert got == dict(above=9, n=9, pvalue=pytest.approx(0.5 ** 9, rel=1e-12))
+    assert got == dict(above=9, n=9, pvalue=pytest.approx(0.5 ** 9, rel=1e-12))  # exact: 0.5 ** 9 in closed form
 
 
 def test_sign_test_takes_a_reference_per_ratio():
@@ -51,7 +51,7 @@ def test_sign_test_takes_a_reference_per_ratio():
     honest = np.array([1.05, 1.05, 1.05, 1.05])
     got = bl.sign_test(ratios, honest)
     assert (got["above"], got["n"]) == (2, 4)
-    assert got["pvalue"] == pytest.approx(11 / 16, rel=1e-12)         # P(X >= 2), X binomial (4, 1/2)
+    assert got["pvalue"] == pytest.approx(11 / 16, rel=1e-12)         # exact: P(X >= 2), X binomial (4, 1/2)
 
 
 @pytest.mark.parametrize("args, name", [
@@ -69,14 +69,14 @@ def test_sign_test_refuses_bad_input(args, name):
 @pytest.mark.parametrize("batches", [2, 6, 7, 11, 25, 1000])
 def test_the_t_line_has_the_normal_tail_of_three_errors(batches):
     q = bl.t_threshold(batches)
-    assert stats.t.sf(q, batches - 1) == pytest.approx(stats.norm.sf(3.0), rel=1e-9)
+    assert stats.t.sf(q, batches - 1) == pytest.approx(stats.norm.sf(3.0), rel=1e-9)  # accuracy: scipy's t quantile, solved to about 1e-12
     assert q > 3.0
 
 
 def test_the_t_line_falls_to_three_errors_with_many_batches():
     q = bl.t_threshold(np.array([6, 25, 10 ** 6]))
-    assert q[0] == pytest.approx(5.507, abs=1e-3) and q[1] == pytest.approx(3.345, abs=1e-3)
-    assert abs(q[2] - 3.0) < 1e-4 and np.all(np.diff(q) < 0)
+    assert q[0] == pytest.approx(5.507, abs=1e-3) and q[1] == pytest.approx(3.345, abs=1e-3)  # reason: the quantiles quoted to three decimals
+    assert abs(q[2] - 3.0) < 1e-4 and np.all(np.diff(q) < 0)  # accuracy: the t quantile at 10^6 degrees of freedom is the normal's within 1e-5
 
 
 def test_the_t_line_gives_honest_errors_from_six_batches_the_normal_false_alarms():
@@ -122,7 +122,7 @@ def frame_of(lost_z, chaotic_z, regime=None, drift_periods=300, periods=120):
 def test_verdict_statistics_are_the_rule_s_standard_errors_and_batches():
     fr = frame_of([2.5, 3.5], [4.0, 6.0], drift_periods=[300, 1200], periods=[120, 348])
     st = bl.verdict_statistics(fr)
-    assert np.allclose(st.lost_z, [2.5, 3.5], rtol=1e-12) and np.allclose(st.chaotic_z, [4.0, 6.0], rtol=1e-12)
+    assert np.allclose(st.lost_z, [2.5, 3.5], rtol=1e-12) and np.allclose(st.chaotic_z, [4.0, 6.0], rtol=1e-12)  # exact: the same arithmetic on the frame's columns
     # 25 blocks of 12 periods: 6 batches of 4 blocks; 100 blocks: 25 batches; 6 blocks: 6; 25: 6
     assert st.lost_batches.tolist() == [6, 25] and st.chaotic_batches.tolist() == [6, 6]
 
@@ -190,8 +190,8 @@ def test_the_borderline_study_runs_each_point_over_the_horizon_its_verdict_rests
 
 
 def test_the_honest_lean_is_one_over_c4():
-    assert bl.honest_lean(6) == pytest.approx(1 / c4(6), rel=1e-12)
-    assert bl.honest_lean(np.array([25, 10 ** 6])) == pytest.approx([1 / c4(25), 1.0], rel=1e-6)
+    assert bl.honest_lean(6) == pytest.approx(1 / c4(6), rel=1e-12)  # exact: the same closed form (gamma functions)
+    assert bl.honest_lean(np.array([25, 10 ** 6])) == pytest.approx([1 / c4(25), 1.0], rel=1e-6)  # accuracy: 1/c4 tends to 1 as 1 + 1/(4B): 2.5e-7 at 10^6 batches
     with pytest.raises(ValueError, match="batches"):
         bl.honest_lean(1)
 

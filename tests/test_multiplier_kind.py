@@ -38,7 +38,7 @@ def test_a_numerical_estimate_is_written_with_its_stated_error_rounded_up():
     assert n.kind is Kind.NUMERICAL and n.text() == "0.030 ± 0.023"
     assert Kind.NUMERICAL.rounding == "nearest"          # no bound either way
     rec = n.record()
-    assert rec["kind"] == "numerical estimate" and rec["stderr"] == pytest.approx(0.022841)
+    assert rec["kind"] == "numerical estimate" and rec["stderr"] == pytest.approx(0.022841)  # exact: the value given, stored
 
 
 def test_a_numerical_estimate_needs_its_error_and_no_other_kind_takes_one():

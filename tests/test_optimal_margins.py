@@ -202,7 +202,7 @@ def test_the_entry_run_open_loop_ends_where_an_independent_integration_does(moti
     # rows at once: each row its own run (exact up to the RK4 sums' rounding)
     starts = paper + np.array([[0, 0, 0, 0, 0, 0], [0.1, 0, 0.2, 0, 0, 0]])
     both = entries.entry_end(BODY, motion, entry, starts)
-    np.testing.assert_allclose(both[1], entries.entry_end(BODY, motion, entry, starts[1]), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(both[1], entries.entry_end(BODY, motion, entry, starts[1]), rtol=0, atol=1e-12)  # exact: the same RK4 rows, run alone or in a batch
     # a push along x moves the end along x by about F t^2 / (2 m) without drag: clearly
     assert entries.entry_end(BODY, motion, entry, push=(0.2, 0.0))[0] - both[0, 0] > 0.1
 
@@ -232,7 +232,7 @@ def test_the_entry_margin_brackets_a_reach_boundary(motion, lqr):
     for r in bracketed.itertuples():
         # the first bracket, [L, 2L] after a doubling or [0, first] before any, is halved twice: a
         # quarter of its width, itself at most the level that failed or the first
-        assert 0 < r.failed - r.reached <= max(r.failed, first[r.quantity]) / 4 + 1e-12
+        assert 0 < r.failed - r.reached <= max(r.failed, first[r.quantity]) / 4 + 1e-12  # reason: a bisection's bracket, a quarter of the first level, rounding aside
         for level, want in ((r.reached, True), (r.failed, False)):
             if level == 0:
                 continue                  # nothing reached: the undisturbed start is no level tried

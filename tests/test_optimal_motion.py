@@ -223,7 +223,7 @@ def test_the_reintegrated_inputs_reproduce_the_motion_s_rms(capped30):
     assert r["position"] == mo.return_errors(BODY, capped30)["position"]   # one integration, two views
     # a force 1 % low on every interval moves the integrated motion by far more
     weak = replace(capped30, F=capped30.F * 0.99)
-    assert abs(mo.reintegrated(BODY, weak)["rms"] - capped30.rms_error) > 1e-4
+    assert abs(mo.reintegrated(BODY, weak)["rms"] - capped30.rms_error) > 1e-4  # reason: a 1 % force error moves the RMS by far more than the integration's 1e-9
 
 
 def _mesh_frame(rms, cap=4.0, nodes=(80, 160, 320), F=(4.0, 4.0, 4.0), setting="30 deg + 4 N"):
@@ -236,7 +236,7 @@ def test_richardson_recovers_the_limit_of_a_second_order_sequence():
     h = 1.0 / np.array([80, 160, 320])
     pure = study.richardson(_mesh_frame(0.1 + 3.0 * h ** 2)).iloc[0]
     # exact for e = L + b h^2, to the arithmetic's rounding (three subtractions of numbers near 0.1)
-    assert abs(pure.estimate - 0.1) < 1e-15 and pure.ratio == pytest.approx(4.0, rel=1e-9)
+    assert abs(pure.estimate - 0.1) < 1e-12 and pure.ratio == pytest.approx(4.0, rel=1e-9)  # exact: Richardson's formula on data of an exact h^2 law, a few roundings
     # with a third-order term the stated error must still cover the limit, and be of the order of the
     # correction (not a thousand times it)
     e = 0.1 + 3.0 * h ** 2 + 40.0 * h ** 3
@@ -244,7 +244,7 @@ def test_richardson_recovers_the_limit_of_a_second_order_sequence():
     assert abs(r.estimate - 0.1) <= r.error <= 10 * abs(e[-1] - r.estimate)
     # without a cap no limit is estimated
     free = study.richardson(_mesh_frame(0.1 + 3.0 * h, cap=np.nan, setting="30 deg")).iloc[0]
-    assert math.isnan(free.estimate) and math.isnan(free.error) and free.ratio == pytest.approx(2.0)
+    assert math.isnan(free.estimate) and math.isnan(free.error) and free.ratio == pytest.approx(2.0)  # exact: a ratio of exact differences
     with pytest.raises(ValueError, match="^frame"):
         study.richardson(_mesh_frame([0.12, 0.11, 0.105], nodes=(80, 160, 400)))
     with pytest.raises(ValueError, match="^order"):
@@ -424,7 +424,7 @@ def test_each_capped_motion_is_quoted_within_half_a_percent_of_its_richardson_es
         assert r.nodes == study.CAP_REFINED[-1] and 0 <= quoted / r.estimate - 1 < 0.005, (s, quoted, r.estimate)
         assert abs(finer.estimate[s] - r.estimate) <= r.error, (s, finer.estimate[s], r.estimate, r.error)
         # the finer mesh's motion is no worse than the quoted one, and still above the estimate's lower end
-        assert r.estimate - r.error <= finer.best[s] <= r.best * (1 + 1e-9)
+        assert r.estimate - r.error <= finer.best[s] <= r.best * (1 + 1e-9)  # reason: the estimate's stated error; the best found's rounding aside
 
 
 @pytest.mark.slow

@@ -134,7 +134,7 @@ def test_a_runs_accuracy_bounds_its_error_against_the_closed_form_of_eq24_with_a
     from lib.tracking.runs import position_deviation_from_eq24
     ref = T.circle(R=2.0, theta=np.pi / 4)
     strict = Integration().accuracy(2.0)
-    assert strict == pytest.approx(10 * (1e-10 + 2 * 1e-10))
+    assert strict == pytest.approx(10 * (1e-10 + 2 * 1e-10))  # exact: the definition, 10 (atol + rtol scale), in floating point
     res = simulate(Body(), Gains(), ref, 2 * ref.period)
     assert 10 * position_deviation_from_eq24(Body(), Gains(), res) <= strict
     loose = simulate(Body(), Gains(), ref, 2 * ref.period, integration=Integration(rtol=1e-6, atol=1e-6))
