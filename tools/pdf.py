@@ -83,19 +83,25 @@ STATIC_PLOTLY = """async () => {
 }"""
 
 #: the part of the single page to print: "book" drops the reference's pages (a ``document-``
-#: anchor of the reference page or of one below it, and the section after it), "reference" keeps
-#: them alone. Returns how many pages were kept.
+#: anchor of the reference page or of one below it, and the section after it) and their lines of
+#: the printed contents, "reference" keeps them alone under the book's title, without the
+#: contents. Returns how many pages were kept (their anchors: the root page has none).
 SELECT_PART = """([part, ref]) => {
   const isRef = id => id === 'document-' + ref || id.startsWith('document-' + ref + '/');
   const anchors = Array.from(document.querySelectorAll('span[id^="document-"]'));
   const refs = anchors.filter(a => isRef(a.id));
+  const toc = document.getElementById('jb-print-toc');      // the printed title page's contents
   if (part === 'book') {
     for (const a of refs) { const s = a.nextElementSibling; if (s) s.remove(); a.remove(); }
+    if (toc) toc.querySelectorAll('a[href^="#document-' + ref + '"]').forEach(l => l.closest('li').remove());
     return anchors.length - refs.length;
   }
   const main = document.querySelector('main .bd-article') || document.querySelector('main') || document.body;
   const top = refs.find(a => a.id === 'document-' + ref);
   main.replaceChildren(top, top.nextElementSibling);
+  if (toc) toc.remove();
+  const title = document.querySelector('#jb-print-docs-body h1');
+  if (title) title.textContent += ': the library reference';
   return refs.length;
 }"""
 #: what the printed page holds: every image in the book's content (the matplotlib figures, the
