@@ -31,6 +31,10 @@ the book's "Library reference" page (``reference.md``) is generated from the doc
 
 import os as _os
 
+#: the model core, by module: what every chapter calls (the parts of the book are its folders)
+__all__ = ["params", "model", "trajectories", "allocation", "control", "closed_loop", "simulate", "angles",
+           "symbolic", "controllability", "stability"]
+
 # numba's parallel kernels run on its OpenMP threading layer, whose threads by default spin
 # while they wait at the end of a parallel loop. The verdicts call the kernels thousands of
 # times on a few rows each (Newton's iterations), so the spinning thread takes a core from

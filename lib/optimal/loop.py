@@ -28,6 +28,7 @@ from scipy.integrate import solve_ivp
 
 from .. import closed_loop
 from ..closed_loop import _weighted_rows
+from ..angles import wrap_angle
 from ..dynamics import verdicts as dv
 from ..dynamics.sampled import sampled_extremes
 from ..integrators.batch import RK4, fixed_steps, integrate, nonfinite_message
@@ -375,7 +376,7 @@ def _orbit_shift(flow: FlowMap, a: LoopVerdict, b: LoopVerdict) -> float:
     for _ in range(1, b.period):
         pts.append(flow.end(pts[-1][None])[0])
     diff = a.orbit - np.array(pts)
-    diff[:, flow.turn_axis] = np.remainder(diff[:, flow.turn_axis] + np.pi, 2 * np.pi) - np.pi
+    diff[:, flow.turn_axis] = wrap_angle(diff[:, flow.turn_axis])
     return float(np.abs(diff).max(axis=1).min())
 
 
