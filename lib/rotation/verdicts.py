@@ -12,6 +12,40 @@ decided again where the last bits may decide them (transient chaos), is in
 :mod:`lib.rotation.fig5`.
 
 Units: R in m, Theta in rad/s, angles in rad, the phase s in rad; w = d phi / ds.
+
+The schedule of :func:`rotation_verdicts`, with its options' defaults (:data:`VERDICT_DEFAULTS`):
+
+1. Transient: ``transient`` periods (48) in chunks of ``chunk`` (8). From
+   ``min_transient`` (8) periods on, after every chunk, a point whose last section
+   states (at s = 0 mod 2 pi) repeat within ``candidate_tol`` (rad) at some lag
+   k <= ``max_period`` (8), up to n whole turns of p, is handed to Newton on
+   P^k(x) - x - (2 pi (n + winding k), 0) (P the period map, its Jacobian exact).
+   It is decided when Newton converges (residual <= ``newton_tol`` rad), all
+   Floquet multipliers (eigenvalues of DP^k) lie inside the unit circle, and the
+   run *reaches this orbit*: its state is within ``reach_tol`` (rad, phi modulo
+   2 pi) of one of the orbit's k points and the distance has shrunk over the
+   last periods, no slower than the slowest multiplier allows (or is below
+   ``reach_floor``). Verdict ``periodic`` (n = 0) or ``slipping`` (n != 0).
+2. Otherwise the largest Lyapunov exponent: a tangent vector carried by the exact
+   Jacobian, renormalised every period, over up to ``lyapunov_periods`` (300)
+   periods; lambda (1/s) is the mean log growth per period divided by the period
+   2 pi / Theta, its standard error from the means of blocks of ``block`` (12)
+   periods (batch means, so that correlated periods do not shrink it; a long run merges
+   them into batches of up to 48 periods, at least 6 of them, as the drift's,
+   :func:`lib.dynamics.statistics.long_run_means`). After every block from
+   ``min_lyapunov_periods`` (72) on, a point that is not clearly
+   expanding is handed to Newton again, and a clearly chaotic one (lambda T above
+   the band and 5 standard errors) stops. If its heading has moved a whole turn, it
+   then runs on without its tangent vector, for its drift alone, to ``drift_periods``
+   (300) periods of Lyapunov run (0: no further), so that the drift's error has
+   batches long against the heading's slips, 48 periods
+   (:func:`lib.dynamics.statistics.drift_statistics`); its regime, exponent and range
+   are those decided when it stopped.
+   At the end: ``chaotic`` when lambda T > max(3 SE, ``lyapunov_band``) (T the
+   period, so the band is per period, 0.01); ``quasiperiodic`` when |lambda T| <=
+   band, its SE <= band / 3, and the section closes on itself: the run comes back
+   near its earlier section states (:func:`section_returns` <= ``return_tol``,
+   0.05), as it does on a closed invariant curve; else ``undecided`` (with a reason).
 """
 
 from __future__ import annotations
@@ -118,37 +152,7 @@ def rotation_verdicts(body: Body, kind: str, R, Theta, *, p0=0.0, v0=0.0, h_lamb
     which gives its point, multipliers and range (the range to about 1e-7 rad; the
     verdict map alone is good to about 1e-5 rad, which the verdict does not need).
 
-    1. Transient: ``transient`` periods (48) in chunks of ``chunk`` (8). From
-       ``min_transient`` (8) periods on, after every chunk, a point whose last section
-       states (at s = 0 mod 2 pi) repeat within ``candidate_tol`` (rad) at some lag
-       k <= ``max_period`` (8), up to n whole turns of p, is handed to Newton on
-       P^k(x) - x - (2 pi (n + winding k), 0) (P the period map, its Jacobian exact).
-       It is decided when Newton converges (residual <= ``newton_tol`` rad), all
-       Floquet multipliers (eigenvalues of DP^k) lie inside the unit circle, and the
-       run *reaches this orbit*: its state is within ``reach_tol`` (rad, phi modulo
-       2 pi) of one of the orbit's k points and the distance has shrunk over the
-       last periods, no slower than the slowest multiplier allows (or is below
-       ``reach_floor``). Verdict ``periodic`` (n = 0) or ``slipping`` (n != 0).
-    2. Otherwise the largest Lyapunov exponent: a tangent vector carried by the exact
-       Jacobian, renormalised every period, over up to ``lyapunov_periods`` (300)
-       periods; lambda (1/s) is the mean log growth per period divided by the period
-       2 pi / Theta, its standard error from the means of blocks of ``block`` (12)
-       periods (batch means, so that correlated periods do not shrink it; a long run merges
-       them into batches of up to 48 periods, at least 6 of them, as the drift's,
-       :func:`lib.dynamics.statistics.long_run_means`). After every block from
-       ``min_lyapunov_periods`` (72) on, a point that is not clearly
-       expanding is handed to Newton again, and a clearly chaotic one (lambda T above
-       the band and 5 standard errors) stops. If its heading has moved a whole turn, it
-       then runs on without its tangent vector, for its drift alone, to ``drift_periods``
-       (300) periods of Lyapunov run (0: no further), so that the drift's error has
-       batches long against the heading's slips, 48 periods
-       (:func:`lib.dynamics.statistics.drift_statistics`); its regime, exponent and range
-       are those decided when it stopped.
-       At the end: ``chaotic`` when lambda T > max(3 SE, ``lyapunov_band``) (T the
-       period, so the band is per period, 0.01); ``quasiperiodic`` when |lambda T| <=
-       band, its SE <= band / 3, and the section closes on itself: the run comes back
-       near its earlier section states (:func:`section_returns` <= ``return_tol``,
-       0.05), as it does on a closed invariant curve; else ``undecided`` (with a reason).
+    The schedule, step by step, is the module's (:mod:`lib.rotation.verdicts`, "The schedule").
 
     ``max_periods`` (option) caps the periods integrated per point (transient first).
 
