@@ -1,4 +1,4 @@
-"""The calibration where the verdicts are decided (lib.dynamics.borderline): the sign test, the t
+"""The calibration where the verdicts are decided (lib.methods.borderline): the sign test, the t
 law of an error read from a few batches, the choice of the borderline points, and the verdicts the
 t law would change."""
 
@@ -9,8 +9,8 @@ import pandas as pd
 import pytest
 from scipy import stats
 
-from lib.dynamics import borderline as bl
-from lib.dynamics import calibration as cal
+from lib.methods import borderline as bl
+from lib.methods import calibration as cal
 from lib.params import Body
 from lib.rotation.verdicts import FIG5_GRID, VERDICT_DEFAULTS
 

@@ -1,5 +1,5 @@
 """The book's standard errors against series whose error is known exactly, and the ensemble
-study that calibrates them (lib.dynamics.statistics, lib.dynamics.calibration)."""
+study that calibrates them (lib.dynamics.statistics, lib.methods.calibration)."""
 
 import math
 
@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 from scipy import stats
 
-from lib.dynamics import calibration as cal
+from lib.methods import calibration as cal
 from lib.dynamics import statistics as st
 from lib.params import Body, Gains
 from lib.rotation.engine import verdict_steps

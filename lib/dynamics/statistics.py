@@ -14,7 +14,7 @@ makes each series' blocks at least :data:`BLOCK_TAUS` times its own tau_int (Sok
 window), whatever shorter block a caller asks for; :func:`drift_statistics` merges a long run's
 blocks into batches of up to :data:`BATCH_PERIODS` periods, :data:`MIN_BATCHES` of them at least
 (:func:`batch_grouping`). The Methods page shows the calibration
-(:mod:`lib.dynamics.calibration`): the spread of an estimate over independent starts against
+(:mod:`lib.methods.calibration`): the spread of an estimate over independent starts against
 the mean standard error reported.
 """
 

@@ -39,7 +39,7 @@ from ..rotation.fig5 import _redo
 from ..rotation.reduced import _initial
 from ..rotation.verdicts import FIG5_GRID, VERDICT_DEFAULTS, _verdict_options, eight_rotation_sweep
 from ..trajectories import eight
-from .statistics import batch_grouping, batch_means, block_statistics, heading_drift, integrated_time
+from ..dynamics.statistics import batch_grouping, batch_means, block_statistics, heading_drift, integrated_time
 
 __all__ = ["ensemble_ratio", "limit_ensemble", "rotation_ensemble", "calibration_study", "ratio_table", "LIMIT_DEG",
            "heading_variogram", "VARIOGRAM_LAGS", "move_counts", "exponent_moves",

@@ -13,7 +13,7 @@ degrees of freedom, not the normal law. That has two consequences measured here.
 reported error is below the spread of the estimates by the factor c4(B) (0.95 at 6 batches),
 so the ratio spread / mean error of an honest error leans above 1, by about 1 / c4: the ratio
 an honest error shows at the starts measured is sqrt(mean SE^2) / mean SE (``honest`` of
-:func:`lib.dynamics.calibration.ensemble_ratio`). And a line at 3 errors is crossed by chance
+:func:`lib.methods.calibration.ensemble_ratio`). And a line at 3 errors is crossed by chance
 more often than the normal tail says; the t quantile of the same tail, :func:`t_threshold`, is
 the correction.
 """
@@ -28,8 +28,8 @@ from ..machinery import checks
 from ..params import Body
 from ..rotation.verdicts import VERDICT_DEFAULTS
 from .calibration import ensemble_ratio, rotation_ensemble
-from .statistics import batch_grouping
-from .verdicts import ORBIT_REGIMES, SIGMAS, TRANSIENT
+from ..dynamics.statistics import batch_grouping
+from ..dynamics.verdicts import ORBIT_REGIMES, SIGMAS, TRANSIENT
 
 __all__ = ["TESTS", "BORDERLINE_STARTS", "PER_SIDE", "WIDTH", "t_threshold", "honest_lean", "verdict_statistics",
            "borderline_points", "borderline_study", "borderline_table", "sign_test", "verdict_changes"]
@@ -178,12 +178,12 @@ def borderline_points(frame: pd.DataFrame, test: str, per_side: int = PER_SIDE, 
 
 def borderline_study(body: Body, frame: pd.DataFrame, starts: int = BORDERLINE_STARTS, *,
                      per_side: int = PER_SIDE, seed: int = 0) -> pd.DataFrame:
-    """The ensemble study of :mod:`lib.dynamics.calibration` at the points of
+    """The ensemble study of :mod:`lib.methods.calibration` at the points of
     :func:`borderline_points` for each test of :data:`TESTS`: ``starts`` random starts at each
-    (:func:`lib.dynamics.calibration.rotation_ensemble`), decided by the map's procedure over the
+    (:func:`lib.methods.calibration.rotation_ensemble`), decided by the map's procedure over the
     horizon the point's verdict rests on (a drift decided again over a longer run,
     :func:`lib.rotation.fig5.confirm_lost`, is run that long, without an early exit), and
-    :func:`lib.dynamics.calibration.ensemble_ratio` of the exponent and of the drift over the
+    :func:`lib.methods.calibration.ensemble_ratio` of the exponent and of the drift over the
     starts that reach no orbit. One row per point and estimator: test, side ("above" or
     "below" the line), setting, R (m), Theta (rad/s), z (the map's statistic, standard errors),
     horizon (periods of Lyapunov run the verdict rests on), free (starts reaching no orbit, of
