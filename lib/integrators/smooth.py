@@ -17,6 +17,8 @@ from typing import Callable
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from ..machinery import checks
+
 __all__ = ["Integration", "SimulationError", "integrate", "SWITCHING"]
 
 #: how a discontinuity of the field (an angle limit) is integrated
@@ -67,9 +69,7 @@ class Integration:
         float
             The accuracy, in the unit of ``scale``.
         """
-        if isinstance(scale, bool) or not np.isscalar(scale) or not scale > 0 or not math.isfinite(scale):
-            raise ValueError(f"scale: a positive finite number, got {scale!r}")
-        return 10.0 * (self.atol + self.rtol * float(scale))
+        return 10.0 * (self.atol + self.rtol * checks.number("scale", scale, positive=True))
 
     def __post_init__(self) -> None:
         for name in ("rtol", "atol", "max_step", "blowup"):

@@ -36,6 +36,8 @@ from dataclasses import dataclass
 from decimal import ROUND_CEILING, ROUND_FLOOR, ROUND_HALF_EVEN, Decimal
 from enum import Enum
 
+from . import checks
+
 __all__ = ["Kind", "Number", "exact", "lower_bound", "upper_bound", "at_most", "at_least", "best_found",
            "estimate", "numerical", "count", "setting", "within_accuracy", "round_directed", "MIME", "BOUNDS",
            "ROUNDOFF"]
@@ -323,10 +325,8 @@ def within_accuracy(measured: float, accuracy: float, fmt: str = ".0e") -> Numbe
         When ``measured`` is not finite, or lies less than ten times below ``accuracy``: then the
         measurement is not round-off, and the bound does not hold with a margin.
     """
-    if isinstance(measured, bool) or not isinstance(measured, (int, float)) or not math.isfinite(measured):
-        raise ValueError(f"measured: a finite number, got {measured!r}")
-    if isinstance(accuracy, bool) or not isinstance(accuracy, (int, float)) or not accuracy > 0:
-        raise ValueError(f"accuracy: a positive number, got {accuracy!r}")
+    measured = checks.number("measured", measured)
+    accuracy = checks.number("accuracy", accuracy, positive=True)
     if not 10 * abs(measured) <= accuracy:
         raise ValueError(f"accuracy: {accuracy!r} is less than ten times the measured {measured!r}: "
                          "the measurement is not round-off, or the method's bound is not the one stated")
