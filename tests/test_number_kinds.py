@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import re
+import sys
 from ast import literal_eval
 from decimal import Decimal
 from pathlib import Path
@@ -230,24 +231,11 @@ def test_a_setting_is_written_exactly_or_refused():
 
 
 def executed_pages() -> dict[str, dict]:
-    """Each page's glued values as the build executed it: page -> {key: (text/plain, record)}."""
-    from jupyter_cache import get_cache
-    from myst_nb.ext.glue import GLUE_PREFIX
-    out = {}
-    cache = get_cache(ROOT / "_build" / ".jupyter_cache")
-    for rec in cache.list_cache_records():
-        nb = cache.get_cache_bundle(rec.pk).nb
-        page = str(Path(rec.uri).resolve().relative_to(ROOT).with_suffix(""))
-        values = {}
-        for cell in nb.cells:
-            for output in cell.get("outputs", []):
-                name = output.get("metadata", {}).get("scrapbook", {}).get("name")
-                data = output.get("data", {})
-                plain = data.get(GLUE_PREFIX + "text/plain", data.get("text/plain"))
-                if name and plain is not None:
-                    values[name] = (plain, data.get(GLUE_PREFIX + kinds.MIME, data.get(kinds.MIME)))
-        out[page] = values
-    return out
+    """Each page's glued values as the build executed it: page -> {key: (text/plain, record)}
+    (``tools/glued.py``, which also compares two builds' values)."""
+    sys.path.insert(0, str(ROOT / "tools"))
+    import glued
+    return glued.executed_glue(ROOT)
 
 
 @pytest.mark.book

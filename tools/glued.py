@@ -22,12 +22,16 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def glued_values(root: Path = ROOT) -> dict[str, dict[str, str]]:
-    """page -> {glued name: its text/plain}, from the execution cache of the book at ``root``."""
+def executed_glue(root: Path = ROOT) -> dict[str, dict[str, tuple[str, dict | None]]]:
+    """page -> {glued name: (its text/plain, the record of its kind or None)}, from the execution
+    cache of the book at ``root`` (a number with a kind carries its value and kind beside its text,
+    :data:`lib.machinery.kinds.MIME`). ``tests/test_number_kinds.py`` reads the pages through it."""
     from jupyter_cache import get_cache
     from myst_nb.ext.glue import GLUE_PREFIX
 
-    out: dict[str, dict[str, str]] = {}
+    from lib.machinery.kinds import MIME
+
+    out: dict[str, dict[str, tuple[str, dict | None]]] = {}
     cache = get_cache(root / "_build" / ".jupyter_cache")
     for rec in cache.list_cache_records():
         nb = cache.get_cache_bundle(rec.pk).nb
@@ -39,8 +43,14 @@ def glued_values(root: Path = ROOT) -> dict[str, dict[str, str]]:
                 data = output.get("data", {})
                 plain = data.get(GLUE_PREFIX + "text/plain", data.get("text/plain"))
                 if name and plain is not None:
-                    values[name] = plain
+                    values[name] = (plain, data.get(GLUE_PREFIX + MIME, data.get(MIME)))
     return out
+
+
+def glued_values(root: Path = ROOT) -> dict[str, dict[str, str]]:
+    """page -> {glued name: its text/plain}, from the execution cache of the book at ``root``."""
+    return {page: {name: plain for name, (plain, _) in glued.items()}
+            for page, glued in executed_glue(root).items()}
 
 
 def differences(before: dict, after: dict) -> list[str]:
